@@ -1,0 +1,1 @@
+"""Element kernels: shape functions, quadrature, reference geometry, layer kernels."""

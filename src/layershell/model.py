@@ -1,0 +1,147 @@
+"""The validated physical model: mesh, layers, stacks, supports, constraints, loads.
+
+Pure data; built by :mod:`layershell.io.build` from a model file or directly in Python.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .material import Orthotropic
+from .mesh import Mesh
+
+
+@dataclass(frozen=True)
+class Layer:
+    """One layer: material, number of directors d (MODEL.md §2: u = Σ (Θ_L³)^l u_l, l=0..d),
+    nodal thickness ``(n_nodes,)`` and material orientation (angle ω about the normal from the
+    tangent-plane projection of ``direction``, or from A_1 if ``direction`` is None)."""
+
+    name: str
+    material: Orthotropic
+    directors: int
+    thickness: np.ndarray
+    angle: float = 0.0
+    direction: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
+class Fix:
+    """Zero displacement of components ``components`` (0..2) of directors ``directors`` of
+    layer ``layer`` at ``nodes``."""
+
+    nodes: np.ndarray
+    layer: int
+    directors: tuple[int, ...]
+    components: tuple[int, ...]
+
+
+@dataclass(frozen=True)
+class Symmetry:
+    """Symmetry plane with unit normal ``normal``: u_l · n = 0 for every director of every layer."""
+
+    nodes: np.ndarray
+    normal: np.ndarray
+
+
+@dataclass(frozen=True)
+class Hinge:
+    """Hinged support at height ``height`` (Θ_1³; None = mid-thickness) in direction ``direction``
+    (global vector, or ``None`` with ``local=True`` for the in-plane edge normal), MODEL.md §8,
+    thesis (3.77)-(3.90). ``fixed``: u_0 of layer 1 also restricted to the hinge direction."""
+
+    nodes: np.ndarray
+    direction: np.ndarray  # (n_nodes_sel, 3) unit vectors, one per node
+    height: np.ndarray | None = None
+    fixed: bool = True
+
+
+@dataclass(frozen=True)
+class NodalLoad:
+    """Director forces given directly: ``values (n_sel, 3)`` on director ``director`` of
+    ``layer`` at ``nodes`` (already integrated, force units × length^director)."""
+
+    nodes: np.ndarray
+    layer: int
+    director: int
+    values: np.ndarray
+    scaled: bool = True
+
+
+@dataclass(frozen=True)
+class SurfaceLoad:
+    """Traction per unit reference area on face ``face`` ('reference', 'top' or 'layer:<k>'
+    bottom face of layer k), direction 'global' vector or 'normal' (A_3), on elements
+    ``elements``; ``magnitude`` is a callable of (x, y, z) arrays -> values. Volume loads use
+    ``face='volume'`` (force per volume, per layer: thesis (2.183))."""
+
+    elements: np.ndarray
+    face: str
+    direction: np.ndarray | None  # None -> along A_3
+    magnitude: object
+    layer: int | None = None  # for 'volume': layer index or None = all
+    scaled: bool = True
+
+
+@dataclass(frozen=True)
+class EdgeLoad:
+    """Traction through the thickness on a lateral face along mesh edges, MODEL.md §6: the
+    traction per unit area is ``distribution(theta3, x, y, z)`` (Θ_1³ from the reference face)
+    times the unit ``direction``; converted to director forces (2.167) per layer and integrated
+    along the edge with the element shape functions."""
+
+    edges: np.ndarray  # (n_edges, 3) node triples (start, mid, end) on the reference surface
+    direction: np.ndarray
+    distribution: object
+    scaled: bool = True
+
+
+@dataclass
+class Model:
+    mesh: Mesh
+    layers: list[Layer]
+    stacks: list[tuple[int, ...]]
+    element_stack: np.ndarray  # (n_elements,) index into stacks
+    fixes: list[Fix] = field(default_factory=list)
+    symmetries: list[Symmetry] = field(default_factory=list)
+    hinges: list[Hinge] = field(default_factory=list)
+    nodal_loads: list[NodalLoad] = field(default_factory=list)
+    surface_loads: list[SurfaceLoad] = field(default_factory=list)
+    edge_loads: list[EdgeLoad] = field(default_factory=list)
+    n_thickness: int = 3
+    nonlinear: bool = True
+    units: str = ""
+
+    def below(self) -> dict[int, int]:
+        """Layer index -> index of the layer directly below it (for layers that are not first)."""
+        out: dict[int, int] = {}
+        for st in self.stacks:
+            for lo, up in zip(st[:-1], st[1:]):
+                if out.setdefault(up, lo) != lo:
+                    raise ValueError(
+                        f"layer '{self.layers[up].name}' lies on '{self.layers[out[up]].name}' in one "
+                        f"stack and on '{self.layers[lo].name}' in another; a layer must sit on the same "
+                        "layer everywhere"
+                    )
+        return out
+
+    def offset(self, layer: int) -> np.ndarray:
+        """Nodal Θ_1³ of the bottom face of ``layer`` (sum of the thicknesses below it)."""
+        b = self.below()
+        h = np.zeros(self.mesh.n_nodes)
+        k = layer
+        while k in b:
+            k = b[k]
+            h = h + self.layers[k].thickness
+        return h
+
+    def total_thickness(self) -> np.ndarray:
+        """Nodal total thickness over the thickest stack at each node."""
+        tot = np.zeros(self.mesh.n_nodes)
+        for si, st in enumerate(self.stacks):
+            nodes = np.unique(self.mesh.elements[self.element_stack == si])
+            top = st[-1]
+            t = self.offset(top) + self.layers[top].thickness
+            tot[nodes] = np.maximum(tot[nodes], t[nodes])
+        return tot

@@ -1,0 +1,153 @@
+"""Results at arbitrary points (ξ, η, Θ_1³) of elements: displacements, strains, stresses.
+
+MODEL.md §3 / thesis (2.81)-(2.114): PK2 and Cauchy stresses as physical components in the
+orthonormal material-aligned bases M_k (undeformed) and m_k (deformed), principal stresses,
+the surface traction vector σ·m_3.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dofs import DofMap
+from .element.geometry import shell_basis, surface_points
+from .element.kernel import basis_gradients, green_lagrange, material_frame, voigt_to_matrix
+from .material import rotate_stiffness
+from .model import Model
+
+
+@dataclass(frozen=True)
+class PointState:
+    """Everything at a set of points (axis p); tensors in Cartesian components."""
+
+    X: np.ndarray  # (p, 3) undeformed position
+    u: np.ndarray  # (p, 3) displacement
+    F: np.ndarray  # (p, 3, 3)
+    E: np.ndarray  # (p, 3, 3) Green-Lagrange strain
+    S: np.ndarray  # (p, 3, 3) 2nd Piola-Kirchhoff
+    sigma: np.ndarray  # (p, 3, 3) Cauchy
+    M: np.ndarray  # (p, 3, 3) rows M_1, M_2, M_3 (undeformed material frame)
+    m: np.ndarray  # (p, 3, 3) rows m_1, m_2, m_3 (deformed frame (2.101)-(2.104))
+    layer: np.ndarray  # (p,) layer index
+
+    @property
+    def pk2_physical(self) -> np.ndarray:
+        """M_k · S · M_l (2.106)."""
+        return np.einsum("pki,pij,plj->pkl", self.M, self.S, self.M)
+
+    @property
+    def cauchy_physical(self) -> np.ndarray:
+        """σ_m^kl = m_k · σ · m_l (2.107)."""
+        return np.einsum("pki,pij,plj->pkl", self.m, self.sigma, self.m)
+
+    def principal(self, measure: str = "cauchy") -> np.ndarray:
+        """Principal stresses, descending (p, 3)."""
+        t = self.cauchy_physical if measure == "cauchy" else self.pk2_physical
+        return np.linalg.eigvalsh(t)[:, ::-1]
+
+    def traction(self) -> np.ndarray:
+        """Surface traction components σ_m^{k3} (2.114): [σ13, σ23, σ33] per point."""
+        return self.cauchy_physical[:, :, 2]
+
+
+def layer_at(model: Model, element: int, theta1: float, layer: int | None = None, tol: float = 1e-9) -> int:
+    """The layer of ``element`` containing Θ_1³ (the lower one on an interface)."""
+    stack = model.stacks[model.element_stack[element]]
+    if layer is not None:
+        if layer not in stack:
+            raise ValueError(f"element {element} has no layer '{model.layers[layer].name}'")
+        return layer
+    conn = model.mesh.elements[element]
+    for k in stack:
+        lo = model.offset(k)[conn].min()
+        hi = (model.offset(k) + model.layers[k].thickness)[conn].max()
+        if lo - tol <= theta1 <= hi + tol:
+            return k
+    return stack[-1]
+
+
+def evaluate_points(
+    model: Model,
+    dm: DofMap,
+    u_full: np.ndarray,
+    elements: np.ndarray,
+    xi: np.ndarray,
+    eta: np.ndarray,
+    theta1: np.ndarray,
+    layers: np.ndarray | None = None,
+    local_theta: bool = False,
+) -> PointState:
+    """Evaluate the state at points ``(element, ξ, η, Θ)``.
+
+    ``theta1`` is Θ_1³ from the reference face, or the layer coordinate Θ_L³ when
+    ``local_theta`` (then ``layers`` is required).
+    """
+    elements = np.atleast_1d(np.asarray(elements, np.int64))
+    p = elements.size
+    xi, eta, theta1 = (np.broadcast_to(np.asarray(v, float), (p,)) for v in (xi, eta, theta1))
+    if layers is None:
+        layers = np.array([layer_at(model, e, t) for e, t in zip(elements, theta1)])
+    layers = np.broadcast_to(np.asarray(layers, np.int64), (p,))
+    out = {k: np.zeros((p, 3, 3)) for k in ("F", "E", "S", "sigma", "M", "m")}
+    X = np.zeros((p, 3))
+    u = np.zeros((p, 3))
+    for k in np.unique(layers):
+        sel = np.flatnonzero(layers == k)
+        ly = model.layers[k]
+        conn = model.mesh.elements[elements[sel]]
+        sp = surface_points(model.mesh.nodes[conn], xi[sel, None], eta[sel, None], per_element=True)
+        off = sp.interpolate(model.offset(k)[conn])[:, 0]
+        thL = theta1[sel] if local_theta else theta1[sel] - off
+        th1 = thL + off
+        G, Ginv, _ = shell_basis(sp, th1[:, None, None])
+        g = basis_gradients(sp, Ginv, thL[:, None, None], ly.directors)[:, 0, 0]  # (s, a, 3)
+        U = u_full[dm.element_dofs(model, k, elements[sel])].reshape(len(sel), -1, 3)
+        phi = (sp.N[:, 0, :, None] * thL[:, None, None] ** np.arange(ly.directors + 1)).reshape(len(sel), -1)
+        u[sel] = np.einsum("sa,sai->si", phi, U)
+        X[sel] = sp.X0[:, 0] + th1[:, None] * sp.A3[:, 0]
+        Hg = np.einsum("sai,saJ->siJ", U, g)
+        F = np.eye(3) + Hg if model.nonlinear else np.broadcast_to(np.eye(3), Hg.shape)
+        Ev = green_lagrange(Hg, model.nonlinear)
+        M = material_frame(sp, ly.angle, ly.direction)[:, 0]
+        C = rotate_stiffness(ly.material.stiffness(), M)
+        S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
+        J = np.linalg.det(F)
+        sig = np.einsum("siI,sIJ,skJ->sik", F, S, F) / J[:, None, None]
+        # deformed frame (2.101)-(2.104): m1 = F M1/|F M1|, m3 = n = g1 x g2/|.|
+        gcov = np.einsum("siJ,sJa->sia", F, G[:, 0, 0])
+        n = np.cross(gcov[..., 0], gcov[..., 1])
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        m1 = np.einsum("siJ,sJ->si", F, M[:, 0])
+        m1 /= np.linalg.norm(m1, axis=1, keepdims=True)
+        m = np.stack([m1, np.cross(n, m1), n], axis=1)
+        out["F"][sel], out["S"][sel], out["sigma"][sel], out["M"][sel], out["m"][sel] = F, S, sig, M, m
+        out["E"][sel] = voigt_to_matrix(Ev * np.array([1, 1, 1, 0.5, 0.5, 0.5]))
+    return PointState(X, u, out["F"], out["E"], out["S"], out["sigma"], out["M"], out["m"], layers.copy())
+
+
+def locate(model: Model, point, tol: float | None = None) -> tuple[int, float, float, float]:
+    """Element and (ξ, η) of the reference-surface point nearest to ``point``, and the distance.
+
+    Projects by Newton iterations on every element near the point and keeps the closest."""
+    point = np.asarray(point, float)
+    mesh = model.mesh
+    centres = mesh.nodes[mesh.elements].mean(1)
+    order = np.argsort(np.linalg.norm(centres - point, axis=1))[:12]
+    best = (1e300, 0, 0.0, 0.0)
+    for e in order:
+        X = mesh.nodes[mesh.elements[e]][None]
+        x = np.zeros(2)
+        for _ in range(30):
+            sp = surface_points(X, x[:1], x[1:])
+            r = sp.X0[0, 0] - point
+            A = sp.A[0, 0]
+            step = np.linalg.lstsq(A, -r, rcond=None)[0]
+            x = np.clip(x + step, -1.0, 1.0)
+            if np.linalg.norm(step) < 1e-13:
+                break
+        sp = surface_points(X, x[:1], x[1:])
+        dist = float(np.linalg.norm(sp.X0[0, 0] - point))
+        if dist < best[0] - 1e-12:
+            best = (dist, int(e), float(x[0]), float(x[1]))
+    return best[1], best[2], best[3], best[0]

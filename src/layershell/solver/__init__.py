@@ -1,0 +1,1 @@
+"""Nonlinear solution: linear solvers, the static problem, Newton-Raphson with load stepping."""

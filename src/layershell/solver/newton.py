@@ -1,0 +1,152 @@
+"""Newton-Raphson with load stepping and automatic bisection, MODEL.md §5 (2.269)-(2.272).
+
+Each iteration solves K_r Δu_r = Tᵀ(λ F_a - f(u)) and updates u = u + T Δu_r. Convergence:
+relative residual ``‖r‖ ≤ tol_residual · ‖Tᵀ λF‖`` and relative energy
+``|Δu·r| ≤ tol_energy · |Δu₀·r₀|``.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Iterator
+
+import numpy as np
+
+from . import linear
+from .problem import Problem
+
+
+@dataclass
+class NewtonSettings:
+    tol_residual: float = 1e-8
+    tol_energy: float = 1e-16
+    max_iterations: int = 25
+    max_bisections: int = 8
+    backend: str = "auto"
+
+
+@dataclass
+class NewtonResult:
+    converged: bool
+    iterations: int
+    residuals: list[float] = field(default_factory=list)
+    message: str = ""
+
+
+@dataclass
+class StepResult:
+    step: int
+    load_factor: float
+    u: np.ndarray  # full-space displacement
+    iterations: int
+    residuals: list[float]
+    bisections: int
+    wall_seconds: float
+
+
+class ConvergenceError(RuntimeError):
+    """Raised when a load increment does not converge after all bisections."""
+
+    def __init__(self, message: str, load_factor: float, residual: float):
+        super().__init__(message)
+        self.load_factor = load_factor
+        self.residual = residual
+
+
+def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
+    """Equilibrium iterations at fixed load factor ``lam`` starting from ``u`` (full space)."""
+    op = problem.op
+    Fext = problem.external(lam)
+    ref = np.linalg.norm(op.reduce(Fext))
+    res = NewtonResult(False, 0)
+    e0 = None
+    for it in range(s.max_iterations + 1):
+        f, K = problem.assembler.evaluate(u, tangent=True)
+        r = op.reduce(Fext - f)
+        rn = float(np.linalg.norm(r))
+        res.residuals.append(rn)
+        if not np.isfinite(rn):
+            res.message = "residual is not finite"
+            return u, res
+        scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
+        if it > 0 and rn <= s.tol_residual * scale:
+            res.converged, res.iterations = True, it
+            return u, res
+        if it == s.max_iterations:
+            break
+        Kr = (op.T.T @ K @ op.T).tocsr()
+        try:
+            du = linear.solve(Kr, r, s.backend)
+        except linear.SingularSystemError as exc:
+            res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
+            return u, res
+        en = abs(float(du @ r))
+        if e0 is None:
+            e0 = en if en > 0 else 1.0
+        u = u + op.expand(du)
+        if not problem.model.nonlinear:  # linear: one solve, then verify the residual once
+            continue
+        if it > 0 and en <= s.tol_energy * e0 and rn <= 1e3 * s.tol_residual * scale:
+            f, _ = problem.assembler.evaluate(u, tangent=False)
+            rn2 = float(np.linalg.norm(op.reduce(Fext - f)))
+            res.residuals.append(rn2)
+            if rn2 <= s.tol_residual * scale:
+                res.converged, res.iterations = True, it + 1
+                return u, res
+    res.iterations = s.max_iterations
+    res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
+    return u, res
+
+
+def load_steps(
+    problem: Problem,
+    load_factors: np.ndarray,
+    settings: NewtonSettings | None = None,
+    u0: np.ndarray | None = None,
+    lam0: float = 0.0,
+    step0: int = 0,
+    on_step_end: Callable[[Problem, np.ndarray, float], bool] | None = None,
+) -> Iterator[StepResult]:
+    """Generator over converged load steps to the target factors ``load_factors``.
+
+    A diverging increment is bisected up to ``max_bisections`` times; converged substeps are
+    not reported separately (the step is reported when its target factor is reached).
+    ``on_step_end(problem, u, lam)`` may change the problem state (delamination) and returns
+    True when the same load level must be solved again.
+    """
+    s = settings or NewtonSettings()
+    u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
+    lam = lam0
+    for n, target in enumerate(load_factors, start=step0 + 1):
+        t0 = time.perf_counter()
+        total_it, bis = 0, 0
+        residuals: list[float] = []
+        inc = target - lam
+        while True:
+            trial = target if abs(target - (lam + inc)) <= 1e-12 * max(1.0, abs(target)) else lam + inc
+            u_new, res = newton(problem, u, trial, s)
+            total_it += res.iterations
+            residuals += res.residuals
+            if res.converged:
+                u, lam = u_new, trial
+                if trial == target:
+                    break
+                inc = min(inc, target - lam) if inc > 0 else max(inc, target - lam)
+                continue
+            bis += 1
+            if bis > s.max_bisections:
+                raise ConvergenceError(
+                    f"step {n}: no convergence towards load factor {trial:.6g} after {s.max_bisections} "
+                    f"bisections ({res.message}); the last converged load factor is {lam:.6g}",
+                    trial, res.residuals[-1] if res.residuals else float("nan"))
+            inc *= 0.5
+        if on_step_end is not None:
+            while on_step_end(problem, u, lam):
+                u, res = newton(problem, u, lam, s)
+                total_it += res.iterations
+                residuals += res.residuals
+                if not res.converged:
+                    raise ConvergenceError(
+                        f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}",
+                        lam, res.residuals[-1] if res.residuals else float("nan"))
+        yield StepResult(n, lam, u.copy(), total_it, residuals, bis, time.perf_counter() - t0)
