@@ -38,7 +38,7 @@ def build_blocks(model: Model, dm: DofMap) -> list[Block]:
         for k in stack:
             ly = model.layers[k]
             ref = layer_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
-                              ly.angle, ly.direction, model.n_thickness)
+                              ly.angle, ly.direction, max(model.n_thickness, ly.directors))
             blocks.append(Block(k, el, dm.element_dofs(model, k, el), ref))
     return blocks
 

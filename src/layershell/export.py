@@ -1,0 +1,273 @@
+"""ParaView output (VTK XML unstructured grids through meshio) and ``.pvd`` time collections.
+
+Per load step two files are written, both atomically (temporary name in the same folder,
+then :func:`os.replace`):
+
+- ``surface_{step:04d}.vtu``: the reference surface as ``quad9`` cells (our node order is the
+  VTK biquadratic quad order) with the nodal director displacements of every layer;
+- ``solid_{step:04d}.vtu``: the shell extruded through its thickness, each layer of each
+  element sampled on a 3×3×3 lattice (in-plane at the 9 nodes, through the layer at
+  Θ_L³ = 0, H_L/2, H_L) split into 8 linear hexahedra, with displacements and the physical
+  stress components of MODEL.md §3 (points duplicated per element and layer because the
+  stresses are discontinuous).
+
+Points are undeformed positions; ParaView's *Warp By Vector* uses the ``displacement`` array.
+"""
+from __future__ import annotations
+
+import os
+import uuid
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from .dofs import DofMap
+from .element.shape import NODE_XI
+from .model import Model
+
+#: physical stress components written, as (row, column) of the 3×3 tensor: 11, 22, 33, 23, 13, 12
+STRESS_COMPONENTS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))
+
+# lattice (i, j) in-plane index (xi = i-1, eta = j-1) -> element node (VTK quad9 order)
+_NODE_OF_IJ = np.empty((3, 3), dtype=np.int64)
+for _a, (_x, _y) in enumerate(NODE_XI):
+    _NODE_OF_IJ[int(_x) + 1, int(_y) + 1] = _a
+
+
+def _lattice_hexes() -> np.ndarray:
+    """(8, 8) local lattice indices (i + 3 j + 9 m) of the hexahedra of one 3×3×3 lattice, in the
+    VTK hexahedron order: bottom quad counter-clockwise about +Θ³, then the top quad."""
+    def idx(i, j, m):
+        return i + 3 * j + 9 * m
+
+    hexes = []
+    for m in range(2):
+        for j in range(2):
+            for i in range(2):
+                bot = [idx(i, j, m), idx(i + 1, j, m), idx(i + 1, j + 1, m), idx(i, j + 1, m)]
+                top = [idx(i, j, m + 1), idx(i + 1, j, m + 1), idx(i + 1, j + 1, m + 1), idx(i, j + 1, m + 1)]
+                hexes.append(bot + top)
+    return np.asarray(hexes, dtype=np.int64)
+
+
+_HEXES = _lattice_hexes()
+_LAT_I = np.tile(np.arange(3), 9)
+_LAT_J = np.tile(np.repeat(np.arange(3), 3), 3)
+_LAT_M = np.repeat(np.arange(3), 9)
+_LAT_NODE = _NODE_OF_IJ[_LAT_I, _LAT_J]  # (27,) element node of each lattice point
+
+
+# ----------------------------------------------------------------------------- helpers
+
+
+def reference_layer(model: Model, dm: DofMap) -> np.ndarray:
+    """(n_nodes,) index of the lowest layer present at each node (smallest offset Θ_1³ of the
+    bottom face; ties to the lower layer index), -1 at nodes without any layer."""
+    nl = len(model.layers)
+    offs = np.full((nl, model.mesh.n_nodes), np.inf)
+    for k in range(nl):
+        offs[k] = np.where(dm.present[k], model.offset(k), np.inf)
+    ref = np.argmin(offs, axis=0)
+    ref[~dm.present.any(axis=0)] = -1
+    return ref
+
+
+def director_field(dm: DofMap, u_full: np.ndarray, layer: int, director: int) -> np.ndarray:
+    """(n_nodes, 3) director ``director`` of ``layer`` at every node, zeros where absent."""
+    d = dm.layer_dofs[layer][:, director, :]
+    out = np.zeros(d.shape, dtype=float)
+    ok = d >= 0
+    out[ok] = u_full[d[ok]]
+    return out
+
+
+def reference_displacement(model: Model, dm: DofMap, u_full: np.ndarray) -> np.ndarray:
+    """(n_nodes, 3) reference-face displacement: director 0 of the lowest layer at each node."""
+    ref = reference_layer(model, dm)
+    out = np.zeros((model.mesh.n_nodes, 3))
+    for k in np.unique(ref[ref >= 0]):
+        sel = ref == k
+        out[sel] = u_full[dm.layer_dofs[k][sel, 0, :]]
+    return out
+
+
+def stress_components(t: np.ndarray) -> np.ndarray:
+    """(p, 3, 3) tensors -> (p, 6) components 11, 22, 33, 23, 13, 12."""
+    return np.stack([t[:, r, c] for r, c in STRESS_COMPONENTS], axis=1)
+
+
+def von_mises(t: np.ndarray) -> np.ndarray:
+    """von Mises equivalent stress of (p, 3, 3) symmetric tensors."""
+    s11, s22, s33 = t[:, 0, 0], t[:, 1, 1], t[:, 2, 2]
+    s23, s13, s12 = t[:, 1, 2], t[:, 0, 2], t[:, 0, 1]
+    return np.sqrt(
+        0.5 * ((s11 - s22) ** 2 + (s22 - s33) ** 2 + (s33 - s11) ** 2) + 3.0 * (s12**2 + s23**2 + s13**2)
+    )
+
+
+def _atomic_write(path: Path, write) -> None:
+    """Call ``write(tmp_path)`` on a temporary file next to ``path`` and rename it into place."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp"
+    try:
+        write(Path(tmp))
+        os.replace(tmp, path)
+    except BaseException:
+        try:
+            os.unlink(tmp)
+        except OSError:
+            pass
+        raise
+
+
+def _write_vtu(path: Path, mesh) -> None:
+    import meshio
+
+    _atomic_write(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
+
+
+# ----------------------------------------------------------------------------- meshes
+
+
+def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
+    """meshio.Mesh of the reference surface with nodal director displacements."""
+    import meshio
+
+    mesh = model.mesh
+    point_data = {"displacement": reference_displacement(model, dm, u_full)}
+    for k, ly in enumerate(model.layers):
+        for d in range(ly.directors + 1):
+            point_data[f"u{d}_{ly.name}"] = director_field(dm, u_full, k, d)
+    cell_data = {
+        "element_id": [np.arange(mesh.n_elements, dtype=np.int64)],
+        "stack": [np.asarray(model.element_stack, dtype=np.int64)],
+    }
+    return meshio.Mesh(
+        np.asarray(mesh.nodes, float),
+        [("quad9", np.asarray(mesh.elements, dtype=np.int64))],
+        point_data=point_data,
+        cell_data=cell_data,
+    )
+
+
+def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
+    """meshio.Mesh of the extruded shell: per element and layer a 3×3×3 lattice, 8 hexahedra."""
+    import meshio
+
+    from .results import evaluate_points
+
+    mesh = model.mesh
+    element_stack = np.asarray(model.element_stack)
+    pts, cells, data = [], [], {k: [] for k in ("displacement", "cauchy", "pk2", "von_mises", "principal")}
+    cell_elem, cell_layer = [], []
+    n_pts = 0
+    for k, ly in enumerate(model.layers):
+        stacks_with = [si for si, st in enumerate(model.stacks) if k in st]
+        elems = np.flatnonzero(np.isin(element_stack, stacks_with))
+        if elems.size == 0:
+            continue
+        ne = elems.size
+        conn = mesh.elements[elems]  # (ne, 9)
+        H = np.asarray(ly.thickness, float)[conn[:, _LAT_NODE]]  # (ne, 27) thickness at lattice nodes
+        thL = 0.5 * _LAT_M[None, :] * H
+        xi = np.broadcast_to(NODE_XI[_LAT_NODE, 0], (ne, 27))
+        eta = np.broadcast_to(NODE_XI[_LAT_NODE, 1], (ne, 27))
+        e_pts = np.repeat(elems, 27)
+        ps = evaluate_points(model, dm, u_full, e_pts, xi.ravel(), eta.ravel(), thL.ravel(), layers=k, local_theta=True)
+        cau = ps.cauchy_physical
+        pts.append(ps.X)
+        data["displacement"].append(ps.u)
+        data["cauchy"].append(stress_components(cau))
+        data["pk2"].append(stress_components(ps.pk2_physical))
+        data["von_mises"].append(von_mises(cau))
+        data["principal"].append(np.linalg.eigvalsh(cau)[:, ::-1])
+        base = n_pts + 27 * np.arange(ne)
+        cells.append((base[:, None, None] + _HEXES[None]).reshape(-1, 8))
+        cell_elem.append(np.repeat(elems, 8))
+        cell_layer.append(np.full(8 * ne, k, dtype=np.int64))
+        n_pts += 27 * ne
+    if not pts:
+        points = np.zeros((0, 3))
+        hexes = np.zeros((0, 8), dtype=np.int64)
+        point_data = {
+            "displacement": np.zeros((0, 3)), "cauchy": np.zeros((0, 6)), "pk2": np.zeros((0, 6)),
+            "von_mises": np.zeros(0), "principal": np.zeros((0, 3)),
+        }
+        cell_data = {"element_id": [np.zeros(0, np.int64)], "layer": [np.zeros(0, np.int64)]}
+    else:
+        points = np.concatenate(pts)
+        hexes = np.concatenate(cells).astype(np.int64)
+        point_data = {name: np.concatenate(v) for name, v in data.items()}
+        cell_data = {
+            "element_id": [np.concatenate(cell_elem).astype(np.int64)],
+            "layer": [np.concatenate(cell_layer)],
+        }
+    return meshio.Mesh(points, [("hexahedron", hexes)], point_data=point_data, cell_data=cell_data)
+
+
+# ----------------------------------------------------------------------------- public API
+
+
+def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.ndarray,
+                load_factor: float) -> dict[str, Path]:
+    """Write ``surface_{step:04d}.vtu`` and ``solid_{step:04d}.vtu`` into ``out_dir``.
+
+    Returns ``{"surface": path, "solid": path}``. ``load_factor`` is not stored in the files
+    (meshio's VTU writer drops field data); it is the time value of the ``.pvd`` collections
+    (:class:`PvdWriter`).
+    """
+    del load_factor  # kept in the signature for the caller's bookkeeping / future metadata
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    u_full = np.asarray(u_full, float)
+    surf = surface_mesh(model, dm, u_full)
+    solid = solid_mesh(model, dm, u_full)
+    paths = {"surface": out_dir / f"surface_{step:04d}.vtu", "solid": out_dir / f"solid_{step:04d}.vtu"}
+    _write_vtu(paths["surface"], surf)
+    _write_vtu(paths["solid"], solid)
+    return paths
+
+
+def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
+    """Write a ParaView collection file listing ``(timestep, file)`` pairs (file names relative
+    to the ``.pvd``), atomically."""
+    path = Path(path)
+    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
+    coll = ET.SubElement(root, "Collection")
+    for t, f in entries:
+        ET.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0", file=str(f))
+    ET.indent(root)
+    text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
+    _atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+class PvdWriter:
+    """Keeps the surface and solid series of a run and rewrites ``surface.pvd`` and
+    ``solid.pvd`` in ``out_dir`` after each :meth:`add`."""
+
+    def __init__(self, out_dir: Path):
+        self.out_dir = Path(out_dir)
+        self.surface: list[tuple[float, str]] = []
+        self.solid: list[tuple[float, str]] = []
+
+    def _rel(self, p: Path) -> str:
+        p = Path(p)
+        try:
+            return Path(os.path.relpath(p.resolve(), self.out_dir.resolve())).as_posix()
+        except ValueError:  # other drive (Windows)
+            return p.resolve().as_posix()
+
+    def add(self, step: int, load_factor: float, paths: dict[str, Path]) -> None:
+        """Register the files of one step (``paths`` as returned by :func:`export_step`)."""
+        if "surface" in paths:
+            self.surface.append((float(load_factor), self._rel(paths["surface"])))
+        if "solid" in paths:
+            self.solid.append((float(load_factor), self._rel(paths["solid"])))
+        self.write()
+
+    def write(self) -> None:
+        self.out_dir.mkdir(parents=True, exist_ok=True)
+        write_pvd(self.out_dir / "surface.pvd", self.surface)
+        write_pvd(self.out_dir / "solid.pvd", self.solid)

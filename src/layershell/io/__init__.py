@@ -1,0 +1,1 @@
+"""Model files (TOML schema, builder), outputs."""

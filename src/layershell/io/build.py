@@ -1,0 +1,319 @@
+"""Model file → validated :class:`~layershell.model.Model` and run settings.
+
+Every error is an :class:`InputError` with one paragraph naming the field and the fix.
+"""
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from pydantic import ValidationError
+
+from .. import mesh as meshmod
+from ..element.shape import EDGES
+from ..formula import FormulaError, compile_formula
+from ..material import MaterialError, Orthotropic
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry
+from ..solver.newton import NewtonSettings
+from . import schema
+
+
+class InputError(ValueError):
+    """Bad input, with a message for the user (exit code 2 in the CLI)."""
+
+
+@dataclass
+class RunSpec:
+    model: Model
+    load_factors: np.ndarray
+    newton: NewtonSettings
+    probes: list  # list[Probe]
+    output: schema.OutputDef
+    source: schema.ModelFile
+    path: Path | None = None
+
+
+XYZ = ("x", "y", "z")
+
+
+def _fmt_loc(loc) -> str:
+    out = ""
+    for p in loc:
+        out += f"[{p}]" if isinstance(p, int) else (f".{p}" if out else str(p))
+    return out
+
+
+def parse(text: str, name: str = "model file") -> schema.ModelFile:
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError(f"{name}: not valid TOML: {exc}") from None
+    try:
+        return schema.ModelFile.model_validate(data)
+    except ValidationError as exc:
+        lines = []
+        for err in exc.errors()[:8]:
+            loc = _fmt_loc(err["loc"])
+            msg = err["msg"].removeprefix("Value error, ")
+            if err["type"] == "extra_forbidden":
+                msg = "unknown key; check the spelling (see docs/model-file.md for the allowed keys)"
+            elif err["type"] == "missing":
+                msg = "required field is missing"
+            inp = err.get("input")
+            got = f" (got {inp!r})" if err["type"] not in ("missing",) and not isinstance(inp, dict) else ""
+            lines.append(f"'{loc}': {msg}{got}" if loc else f"{msg}")
+        more = f" … and {len(exc.errors()) - 8} more" if len(exc.errors()) > 8 else ""
+        raise InputError(f"{name}: " + "; ".join(lines) + more) from None
+
+
+def load(path: str | Path) -> RunSpec:
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"model file '{path}' does not exist")
+    mf = parse(path.read_text(encoding="utf-8"), str(path))
+    spec = build(mf, path.parent)
+    spec.path = path
+    return spec
+
+
+# ------------------------------------------------------------------ helpers
+def _formula(text, variables, field: str):
+    try:
+        return compile_formula(str(text), variables)
+    except FormulaError as exc:
+        raise InputError(f"'{field}': {exc}") from None
+
+
+def _field_fn(value, field: str, variables=XYZ):
+    """Number or formula -> vectorised callable of keyword arrays."""
+    if isinstance(value, (int, float)):
+        v = float(value)
+        return lambda **kw: np.full(np.broadcast(*kw.values()).shape if kw else (), v)
+    f = _formula(value, variables, field)
+    return lambda **kw: f(**kw)
+
+
+def _node_selection(m: meshmod.Mesh, sel, field: str, required: bool = True) -> np.ndarray:
+    where, set_, point = getattr(sel, "where", None), getattr(sel, "set", None), getattr(sel, "point", None)
+    given = [g for g in (where, set_, point) if g is not None]
+    if len(given) != 1:
+        raise InputError(f"'{field}': give exactly one of 'where', 'set' or 'point' to select nodes")
+    x = m.nodes
+    lo, hi = x.min(0), x.max(0)
+    span = ", ".join(f"{c} ∈ [{a:.6g}, {b:.6g}]" for c, a, b in zip(XYZ, lo, hi))
+    if point is not None:
+        d = np.linalg.norm(x - np.asarray(point), axis=1)
+        return np.array([int(np.argmin(d))])
+    if set_ is not None:
+        if set_ not in m.node_sets:
+            raise InputError(f"'{field}.set': the mesh has no node set '{set_}'; "
+                             f"available: {sorted(m.node_sets) or 'none'}")
+        nodes = np.asarray(m.node_sets[set_])
+    else:
+        f = _formula(where, XYZ, f"{field}.where")
+        try:
+            mask = np.broadcast_to(f(tol=1e-6 * m.size(), x=x[:, 0], y=x[:, 1], z=x[:, 2]), (m.n_nodes,))
+        except FormulaError as exc:
+            raise InputError(f"'{field}.where': {exc}") from None
+        nodes = np.flatnonzero(mask)
+    if required and nodes.size == 0:
+        raise InputError(f"'{field}': the selection '{where or set_}' selects no node; the model spans {span} "
+                         "(use near(x, value) to compare coordinates with a tolerance)")
+    return nodes
+
+
+def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
+    where, set_ = getattr(sel, "where", None), getattr(sel, "set", None)
+    if where is None and set_ is None:
+        return np.arange(m.n_elements)
+    if set_ is not None:
+        if set_ not in m.element_sets:
+            raise InputError(f"'{field}.set': the mesh has no element set '{set_}'; "
+                             f"available: {sorted(m.element_sets) or 'none'}")
+        return np.asarray(m.element_sets[set_])
+    c = m.nodes[m.elements[:, 8]]
+    f = _formula(where, XYZ, f"{field}.where")
+    el = np.flatnonzero(np.broadcast_to(f(tol=1e-6 * m.size(), x=c[:, 0], y=c[:, 1], z=c[:, 2]), (m.n_elements,)))
+    if el.size == 0:
+        raise InputError(f"'{field}.where': '{where}' selects no element (tested at element centres)")
+    return el
+
+
+def boundary_edges(m: meshmod.Mesh) -> np.ndarray:
+    """(n, 3) node triples of edges that belong to one element only."""
+    tri = m.elements[:, EDGES].reshape(-1, 3)
+    mids, counts = np.unique(tri[:, 1], return_counts=True)
+    single = set(mids[counts == 1].tolist())
+    return np.array([t for t in tri if t[1] in single], dtype=np.int64).reshape(-1, 3)
+
+
+def _mesh(md, base: Path) -> meshmod.Mesh:
+    if md.type == "rectangle":
+        return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal)
+    if md.type == "cylinder":
+        return meshmod.cylinder(md.radius, md.angle_start, md.angle_end, md.width, md.n_arc, md.n_width,
+                                md.normal, md.axis)
+    if md.type == "revolution":
+        return meshmod.revolution(md.meridian_r, md.meridian_z, md.n_meridian, md.n_circ, md.angle, md.normal)
+    from .meshfile import read_mesh
+
+    return read_mesh(base / md.path, md.scale)
+
+
+def _material(name: str, md) -> Orthotropic:
+    if md.type == "isotropic":
+        mat = Orthotropic.isotropic(md.E, md.nu, md.density, name)
+    elif md.nu31 is not None:
+        mat = Orthotropic(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu31, md.density, name)
+    else:
+        mat = Orthotropic.from_nu13(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu13,
+                                    md.density, name)
+    try:
+        mat.check()
+    except MaterialError as exc:
+        raise InputError(f"'materials.{name}': {exc}") from None
+    return mat
+
+
+def _vec(v, field: str) -> np.ndarray:
+    a = np.asarray(v, float)
+    n = np.linalg.norm(a)
+    if not n > 0:
+        raise InputError(f"'{field}': the direction vector must not be zero")
+    return a / n
+
+
+# ------------------------------------------------------------------ build
+def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
+    try:
+        m = _mesh(mf.mesh, base)
+        m.check()
+    except meshmod.MeshError as exc:
+        raise InputError(f"'mesh': {exc}") from None
+    mats = {k: _material(k, v) for k, v in mf.materials.items()}
+    names = [ly.name for ly in mf.layers]
+    index = {n: i for i, n in enumerate(names)}
+    layers = []
+    for i, ld in enumerate(mf.layers):
+        fn = _field_fn(ld.thickness, f"layers[{i}].thickness")
+        th = np.broadcast_to(fn(x=m.nodes[:, 0], y=m.nodes[:, 1], z=m.nodes[:, 2]), (m.n_nodes,)).astype(float)
+        if not np.all(th > 0):
+            bad = np.flatnonzero(~(th > 0))
+            raise InputError(f"'layers[{i}].thickness': must be positive at every node, but is {th[bad[0]]:.6g} "
+                             f"at node {bad[0]} {m.nodes[bad[0]].round(6).tolist()} ({bad.size} nodes)")
+        layers.append(Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle,
+                            tuple(ld.direction) if ld.direction is not None else None))
+
+    def layer_idx(name, field):
+        if name is None:
+            return None
+        if name not in index:
+            raise InputError(f"'{field}': unknown layer '{name}'; defined: {names}")
+        return index[name]
+
+    # stacks
+    if mf.stacks is None:
+        stacks = [tuple(range(len(layers)))]
+        element_stack = np.zeros(m.n_elements, np.int64)
+    else:
+        stacks, element_stack = [], np.full(m.n_elements, -1, np.int64)
+        for i, sd in enumerate(mf.stacks):
+            st = tuple(layer_idx(n, f"stacks[{i}].layers") for n in sd.layers)
+            el = _element_selection(m, sd, f"stacks[{i}]")
+            stacks.append(st)
+            element_stack[el] = i
+        if np.any(element_stack < 0):
+            bad = np.flatnonzero(element_stack < 0)
+            raise InputError(f"'stacks': {bad.size} element(s) belong to no stack (first: element {bad[0]}); "
+                             "add a stack without 'where' or widen the selections")
+    model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
+                  nonlinear=mf.model.nonlinear, units=mf.model.units)
+    try:
+        model.below()
+    except ValueError as exc:
+        raise InputError(f"'stacks': {exc}") from None
+    first = stacks[0][0]
+
+    # supports
+    for i, sd in enumerate(mf.supports):
+        f = f"supports[{i}]"
+        nodes = _node_selection(m, sd, f)
+        if sd.type == "fix":
+            k = layer_idx(sd.layer, f + ".layer")
+            k = first if k is None else k
+            d = layers[k].directors
+            dirs = tuple(range(d + 1)) if sd.directors == "all" else tuple(sd.directors)
+            if any(l > d or l < 0 for l in dirs):
+                raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dirs)}")
+            model.fixes.append(Fix(nodes, k, dirs, tuple(XYZ.index(c) for c in sd.components)))
+        elif sd.type == "symmetry":
+            model.symmetries.append(Symmetry(nodes, _vec(sd.normal, f + ".normal")))
+        else:
+            model.hinges.append(Hinge(nodes, np.tile(_vec(sd.direction, f + ".direction"), (len(nodes), 1)),
+                                      None if sd.height is None else np.full(len(nodes), sd.height), sd.fixed))
+    # loads
+    bedges = None
+    for i, ld in enumerate(mf.loads):
+        f = f"loads[{i}]"
+        if ld.type == "surface":
+            el = _element_selection(m, ld, f)
+            face = ld.face
+            if face.startswith("layer:"):
+                face = f"layer:{layer_idx(face.split(':', 1)[1], f + '.face')}"
+            elif face not in ("reference", "top"):
+                raise InputError(f"'{f}.face': unknown face '{ld.face}'; use 'reference', 'top' or 'layer:<name>'")
+            direction = None if ld.direction == "normal" else _vec(ld.direction, f + ".direction")
+            model.surface_loads.append(SurfaceLoad(el, face, direction, _field_fn(ld.magnitude, f + ".magnitude"),
+                                                   scaled=ld.scaled))
+        elif ld.type in ("volume", "gravity"):
+            el = _element_selection(m, ld, f)
+            if ld.type == "volume":
+                k = layer_idx(ld.layer, f + ".layer")
+                v = np.asarray(ld.value, float)
+                n = np.linalg.norm(v)
+                model.surface_loads.append(SurfaceLoad(el, "volume", v / n if n else v,
+                                                       lambda x, y, z, n=n: np.full(np.shape(x), n), k, ld.scaled))
+            else:
+                g = np.asarray(ld.g, float)
+                gn = np.linalg.norm(g)
+                for k, ly in enumerate(layers):
+                    if ly.material.density > 0 and gn > 0:
+                        w = ly.material.density * gn
+                        model.surface_loads.append(SurfaceLoad(el, "volume", g / gn,
+                                                               lambda x, y, z, w=w: np.full(np.shape(x), w), k,
+                                                               ld.scaled))
+        elif ld.type == "edge":
+            bedges = boundary_edges(m) if bedges is None else bedges
+            nodes = _node_selection(m, ld, f)
+            mask = np.zeros(m.n_nodes, bool)
+            mask[nodes] = True
+            edges = bedges[mask[bedges].all(1)]
+            if edges.size == 0:
+                raise InputError(f"'{f}': the selection picks nodes but no complete boundary edge "
+                                 "(all three nodes of an element edge must be selected)")
+            dist = _field_fn(ld.distribution, f + ".distribution", ("t", "x", "y", "z"))
+            model.edge_loads.append(EdgeLoad(edges, _vec(ld.direction, f + ".direction"),
+                                             lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled))
+        else:  # nodal
+            nodes = _node_selection(m, ld, f)
+            k = layer_idx(ld.layer, f + ".layer")
+            k = first if k is None else k
+            if ld.director > layers[k].directors:
+                raise InputError(f"'{f}.director': layer '{layers[k].name}' has directors 0..{layers[k].directors}")
+            model.nodal_loads.append(NodalLoad(nodes, k, ld.director, np.asarray(ld.value, float), ld.scaled))
+
+    st = mf.steps
+    if st.factors is not None:
+        lf = np.asarray(st.factors, float)
+        if lf.size == 0:
+            raise InputError("'steps.factors': give at least one load factor")
+    else:
+        lf = st.lambda_end * np.arange(1, st.n + 1) / st.n
+    newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
+                            max_bisections=st.max_bisections, backend=st.solver)
+    from .probes import build_probes
+
+    probes = build_probes(mf, model, index, _node_selection)
+    return RunSpec(model, lf, newton, probes, mf.output, mf)

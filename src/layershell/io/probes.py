@@ -1,0 +1,128 @@
+"""Probes: named scalar outputs evaluated after every converged step."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..element.shape import NODE_XI
+from ..results import PointState, evaluate_points, locate
+
+STRESS_COMPONENTS = {"11": (0, 0), "22": (1, 1), "33": (2, 2), "23": (1, 2), "13": (0, 2), "12": (0, 1)}
+TRACTION_COMPONENTS = ("13", "23", "33", "shear")
+
+
+class ProbeError(ValueError):
+    pass
+
+
+@dataclass
+class Probe:
+    name: str
+    quantity: str
+    component: str
+    measure: str
+    elements: np.ndarray  # (p,) evaluation points
+    xi: np.ndarray
+    eta: np.ndarray
+    theta: np.ndarray
+    layer: int | None
+    local_theta: bool
+    reduce: str
+    scale: float
+
+    def points(self, model, dm, u) -> PointState:
+        layers = None if self.layer is None else np.full(self.elements.size, self.layer)
+        return evaluate_points(model, dm, u, self.elements, self.xi, self.eta, self.theta, layers, self.local_theta)
+
+    def samples(self, model, dm, u) -> np.ndarray:
+        ps = self.points(model, dm, u)
+        c = self.component
+        if self.quantity == "displacement":
+            vals = np.linalg.norm(ps.u, axis=1) if c == "magnitude" else ps.u[:, "xyz".index(c)]
+        elif self.quantity == "traction":
+            t = ps.traction()
+            vals = np.hypot(t[:, 0], t[:, 1]) if c == "shear" else t[:, {"13": 0, "23": 1, "33": 2}[c]]
+        else:
+            T = ps.cauchy_physical if self.measure == "cauchy" else ps.pk2_physical
+            if c in STRESS_COMPONENTS:
+                i, j = STRESS_COMPONENTS[c]
+                vals = T[:, i, j]
+            elif c in ("p1", "p2", "p3"):
+                vals = np.linalg.eigvalsh(T)[:, ::-1][:, int(c[1]) - 1]
+            else:  # von_mises
+                dev = T - np.trace(T, axis1=1, axis2=2)[:, None, None] / 3 * np.eye(3)
+                vals = np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
+        return self.scale * vals
+
+    def value(self, model, dm, u) -> float:
+        v = self.samples(model, dm, u)
+        if self.reduce == "max":
+            return float(v.max())
+        if self.reduce == "min":
+            return float(v.min())
+        if self.reduce == "absmax":
+            return float(v[np.argmax(np.abs(v))])
+        if self.reduce == "mean":
+            return float(v.mean())
+        return float(v[0])
+
+
+def _node_points(model, nodes):
+    """An (element, ξ, η) for each node."""
+    el_of = np.full(model.mesh.n_nodes, -1)
+    loc_of = np.zeros(model.mesh.n_nodes, np.int64)
+    E = model.mesh.elements
+    el_of[E[::-1].ravel()] = np.repeat(np.arange(len(E))[::-1], 9)
+    loc_of[E[::-1].ravel()] = np.tile(np.arange(9), len(E))
+    return el_of[nodes], NODE_XI[loc_of[nodes], 0], NODE_XI[loc_of[nodes], 1]
+
+
+def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
+    from .build import InputError
+
+    out = []
+    for i, pd in enumerate(mf.probes):
+        f = f"probes[{i}]"
+        k = None
+        if pd.layer is not None:
+            if pd.layer not in layer_index:
+                raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'")
+            k = layer_index[pd.layer]
+        comp = pd.component
+        allowed = {"displacement": ("x", "y", "z", "magnitude"),
+                   "stress": tuple(STRESS_COMPONENTS) + ("p1", "p2", "p3", "von_mises"),
+                   "traction": TRACTION_COMPONENTS}[pd.quantity]
+        if comp not in allowed:
+            raise InputError(f"'{f}.component': '{comp}' is not a {pd.quantity} component; use one of {list(allowed)}")
+        if isinstance(pd.theta3, list):
+            a, b, n = pd.theta3
+            if n < 1 or int(n) != n:
+                raise InputError(f"'{f}.theta3': [start, end, n] needs an integer n >= 1")
+            th = np.linspace(a, b, int(n))
+        else:
+            th = np.array([float(pd.theta3)])
+        local = False
+        if pd.quantity == "traction":
+            if k is None:
+                raise InputError(f"'{f}.layer': a traction probe needs the layer whose bottom face is meant")
+            th, local = np.zeros(1), True
+        if pd.quantity == "displacement":
+            nodes = node_selection(model.mesh, pd, f)
+            el, xi, eta = _node_points(model, nodes)
+        else:
+            if pd.point is None:
+                raise InputError(f"'{f}.point': a {pd.quantity} probe needs a point on the reference surface")
+            e, x, y, dist = locate(model, pd.point)
+            if dist > 1e-3 * model.mesh.size():
+                raise InputError(f"'{f}.point': {pd.point} is {dist:.4g} away from the reference surface; "
+                                 "give a point on the reference surface (Θ³ = 0) and the height in theta3")
+            el, xi, eta = np.array([e]), np.array([x]), np.array([y])
+        P = el.size
+        el_all = np.repeat(el, th.size)
+        xi_all = np.repeat(xi, th.size)
+        eta_all = np.repeat(eta, th.size)
+        th_all = np.tile(th, P)
+        out.append(Probe(pd.name, pd.quantity, comp, pd.measure, el_all, xi_all, eta_all, th_all, k, local,
+                         pd.reduce, pd.scale))
+    return out

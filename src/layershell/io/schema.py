@@ -1,0 +1,279 @@
+"""The TOML model-file schema, validated with pydantic (every error names its field).
+
+See ``docs/model-file.md`` for the reference; each example under ``examples/`` is a
+complete model file. Formulas (thickness, load magnitudes, selections) are parsed by the safe
+parser :mod:`layershell.formula`, never ``eval``.
+"""
+from __future__ import annotations
+
+from typing import Annotated, Literal, Union
+
+from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, field_validator, model_validator
+
+Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
+NumOrFormula = Union[float, str]
+
+
+class Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+# ------------------------------------------------------------------ general settings
+class ModelSettings(Strict):
+    title: str = ""
+    units: str = Field("", description="unit system, for reports only (e.g. 'kN, m')")
+    nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
+    thickness_points: PositiveInt = Field(
+        3, le=10, description="Gauss points through each layer (at least d are used: d = 4 needs 4)")
+
+
+# ------------------------------------------------------------------ meshes
+class RectangleMesh(Strict):
+    type: Literal["rectangle"]
+    lx: PositiveFloat
+    ly: PositiveFloat
+    nx: PositiveInt
+    ny: PositiveInt
+    origin: Vec3 = [0.0, 0.0, 0.0]
+    normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
+
+
+class CylinderMesh(Strict):
+    type: Literal["cylinder"]
+    radius: PositiveFloat = Field(description="radius of the reference face")
+    angle_start: float = 0.0
+    angle_end: float = Field(description="degrees")
+    width: PositiveFloat
+    n_arc: PositiveInt
+    n_width: PositiveInt = 1
+    normal: Literal["inward", "outward"] = Field(
+        "inward", description="'inward': reference face outside (A3 towards the axis)")
+    axis: Literal["z", "y"] = "z"
+
+
+class RevolutionMesh(Strict):
+    type: Literal["revolution"]
+    meridian_r: list[float] = Field(min_length=2)
+    meridian_z: list[float] = Field(min_length=2)
+    n_meridian: PositiveInt
+    n_circ: PositiveInt
+    angle: float = Field(360.0, gt=0, le=360)
+    normal: Literal["inward", "outward"] = "outward"
+
+    @model_validator(mode="after")
+    def _same_length(self):
+        if len(self.meridian_r) != len(self.meridian_z):
+            raise ValueError("meridian_r and meridian_z must have the same length")
+        return self
+
+
+class FileMesh(Strict):
+    type: Literal["file"]
+    path: str = Field(description="mesh file read with meshio (Gmsh .msh, .vtu, ...), relative to the model file")
+    scale: PositiveFloat = 1.0
+
+
+Mesh = Annotated[Union[RectangleMesh, CylinderMesh, RevolutionMesh, FileMesh], Field(discriminator="type")]
+
+
+# ------------------------------------------------------------------ materials and layers
+class Isotropic(Strict):
+    type: Literal["isotropic"]
+    E: float
+    nu: float
+    density: float = 0.0
+
+
+class OrthotropicMat(Strict):
+    type: Literal["orthotropic"]
+    E1: float
+    E2: float
+    E3: float
+    G12: float
+    G23: float
+    G31: float
+    nu12: float
+    nu23: float
+    nu31: float | None = None
+    nu13: float | None = Field(None, description="give nu13 instead of nu31 (nu31 = nu13 E3/E1)")
+    density: float = 0.0
+
+    @model_validator(mode="after")
+    def _one_of(self):
+        if (self.nu31 is None) == (self.nu13 is None):
+            raise ValueError("give exactly one of nu31 and nu13")
+        return self
+
+
+Material = Annotated[Union[Isotropic, OrthotropicMat], Field(discriminator="type")]
+
+
+class LayerDef(Strict):
+    name: str = Field(min_length=1)
+    material: str
+    thickness: NumOrFormula = Field(description="number or formula in x, y, z (evaluated at the nodes)")
+    directors: int = Field(3, ge=0, le=4, description="d: u = Σ_{l=0..d} (Θ³)^l u_l")
+    angle: float = Field(0.0, description="material angle ω in degrees about the normal")
+    direction: Vec3 | None = Field(None, description="global direction projected on the surface as material axis 1")
+
+    @field_validator("thickness")
+    @classmethod
+    def _positive(cls, v):
+        if isinstance(v, (int, float)) and not v > 0:
+            raise ValueError(f"thickness must be positive (got {v})")
+        return v
+
+
+class StackDef(Strict):
+    layers: list[str] = Field(min_length=1, description="layer names from the reference face outward")
+    where: str | None = Field(None, description="formula on element centres selecting the elements")
+    set: str | None = None
+
+
+# ------------------------------------------------------------------ supports
+Component = Literal["x", "y", "z"]
+
+
+class FixDef(Strict):
+    type: Literal["fix"]
+    where: str | None = None
+    set: str | None = None
+    point: Vec3 | None = None
+    layer: str | None = Field(None, description="default: the layer at the reference face")
+    directors: Union[Literal["all"], list[int]] = [0]
+    components: list[Component] = ["x", "y", "z"]
+
+
+class SymmetryDef(Strict):
+    type: Literal["symmetry"]
+    where: str | None = None
+    set: str | None = None
+    point: Vec3 | None = None
+    normal: Vec3
+
+
+class HingeDef(Strict):
+    type: Literal["hinge"]
+    where: str | None = None
+    set: str | None = None
+    point: Vec3 | None = None
+    direction: Vec3 = Field(description="hinge direction (global), not the thickness direction")
+    height: float | None = Field(None, description="Θ³ of the hinge; default mid-thickness")
+    fixed: bool = Field(True, description="fixed hinge (u0 of the first layer along 'direction' only) or sliding")
+
+
+Support = Annotated[Union[FixDef, SymmetryDef, HingeDef], Field(discriminator="type")]
+
+
+# ------------------------------------------------------------------ loads
+class SurfaceLoadDef(Strict):
+    type: Literal["surface"]
+    face: str = Field("reference", description="'reference', 'top' or 'layer:<name>' (bottom face of that layer)")
+    where: str | None = None
+    set: str | None = None
+    direction: Union[Vec3, Literal["normal"]] = Field(description="global vector or 'normal' (A3)")
+    magnitude: NumOrFormula = Field(description="force per reference area; number or formula in x, y, z")
+    scaled: bool = Field(True, description="multiplied by the load factor λ")
+
+
+class EdgeLoadDef(Strict):
+    type: Literal["edge"]
+    where: str | None = Field(None, description="boundary edges whose three nodes satisfy this formula")
+    set: str | None = None
+    direction: Vec3
+    distribution: NumOrFormula = Field(
+        description="traction per area through the thickness: formula in t (Θ³ from the reference face), x, y, z")
+    scaled: bool = True
+
+
+class VolumeLoadDef(Strict):
+    type: Literal["volume"]
+    where: str | None = None
+    set: str | None = None
+    layer: str | None = None
+    value: Vec3 = Field(description="force per volume")
+    scaled: bool = True
+
+
+class GravityDef(Strict):
+    type: Literal["gravity"]
+    where: str | None = None
+    set: str | None = None
+    g: Vec3 = [0.0, 0.0, -9.81]
+    scaled: bool = True
+
+
+class NodalLoadDef(Strict):
+    type: Literal["nodal"]
+    where: str | None = None
+    set: str | None = None
+    point: Vec3 | None = None
+    layer: str | None = None
+    director: int = Field(0, ge=0, le=4)
+    value: Vec3
+    scaled: bool = True
+
+
+Load = Annotated[Union[SurfaceLoadDef, EdgeLoadDef, VolumeLoadDef, GravityDef, NodalLoadDef],
+                 Field(discriminator="type")]
+
+
+# ------------------------------------------------------------------ stepping and probes
+class Steps(Strict):
+    n: PositiveInt = Field(1, description="equal load steps from 0 to lambda_end")
+    lambda_end: float = 1.0
+    factors: list[float] | None = Field(None, description="explicit load factors (instead of n/lambda_end)")
+    tolerance: PositiveFloat = 1e-8
+    max_iterations: PositiveInt = 25
+    max_bisections: int = Field(8, ge=0, le=30)
+    solver: Literal["auto", "superlu", "pardiso"] = "auto"
+
+
+class ProbeDef(Strict):
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    quantity: Literal["displacement", "stress", "traction"]
+    point: Vec3 | None = Field(None, description="displacement: nearest node; stress: point on the reference surface")
+    where: str | None = Field(None, description="displacement: node selection (use with reduce)")
+    set: str | None = None
+    component: str = Field(description="x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises")
+    measure: Literal["cauchy", "pk2"] = "cauchy"
+    theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
+        0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
+    layer: str | None = None
+    reduce: Literal["max", "min", "absmax", "mean", "none"] = "none"
+    scale: float = 1.0
+
+
+class OutputDef(Strict):
+    vtu: bool = True
+    plots: bool = True
+    every: PositiveInt = Field(1, description="write ParaView files every n-th step (the last is always written)")
+
+
+class ModelFile(Strict):
+    model: ModelSettings = ModelSettings()
+    mesh: Mesh
+    materials: dict[str, Material] = Field(min_length=1)
+    layers: list[LayerDef] = Field(min_length=1)
+    stacks: list[StackDef] | None = None
+    supports: list[Support] = []
+    loads: list[Load] = []
+    steps: Steps = Steps()
+    probes: list[ProbeDef] = []
+    output: OutputDef = OutputDef()
+
+    @model_validator(mode="after")
+    def _names(self):
+        names = [ly.name for ly in self.layers]
+        dup = {n for n in names if names.count(n) > 1}
+        if dup:
+            raise ValueError(f"layer names must be unique: {sorted(dup)}")
+        for i, ly in enumerate(self.layers):
+            if ly.material not in self.materials:
+                raise ValueError(f"layers[{i}].material: unknown material '{ly.material}'; "
+                                 f"defined: {sorted(self.materials)}")
+        pn = [p.name for p in self.probes]
+        dup = {n for n in pn if pn.count(n) > 1}
+        if dup:
+            raise ValueError(f"probe names must be unique: {sorted(dup)}")
+        return self
