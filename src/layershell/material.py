@@ -38,6 +38,9 @@ class Orthotropic:
 
     @classmethod
     def isotropic(cls, E: float, nu: float, density: float = 0.0, name: str = "material") -> "Orthotropic":
+        if not -1.0 < nu < 0.5:
+            raise MaterialError(f"material '{name}': the Poisson ratio nu={nu} must lie in (-1, 0.5) for a "
+                                "positive definite isotropic law")
         G = E / (2.0 * (1.0 + nu))
         return cls(E, E, E, G, G, G, nu, nu, nu, density, name)
 

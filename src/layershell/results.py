@@ -17,6 +17,12 @@ from .material import rotate_stiffness
 from .model import Model
 
 
+def cauchy_stress(F: np.ndarray, S: np.ndarray) -> np.ndarray:
+    """σ = J⁻¹ F S Fᵀ (2.88) for batched ``F, S (..., 3, 3)``."""
+    J = np.linalg.det(F)
+    return np.einsum("...iI,...IJ,...kJ->...ik", F, S, F) / J[..., None, None]
+
+
 @dataclass(frozen=True)
 class PointState:
     """Everything at a set of points (axis p); tensors in Cartesian components."""
@@ -112,8 +118,7 @@ def evaluate_points(
         M = material_frame(sp, ly.angle, ly.direction)[:, 0]
         C = rotate_stiffness(ly.material.stiffness(), M)
         S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
-        J = np.linalg.det(F)
-        sig = np.einsum("siI,sIJ,skJ->sik", F, S, F) / J[:, None, None]
+        sig = cauchy_stress(F, S)
         # deformed frame (2.101)-(2.104): m1 = F M1/|F M1|, m3 = n = g1 x g2/|.|
         gcov = np.einsum("siJ,sJa->sia", F, G[:, 0, 0])
         n = np.cross(gcov[..., 0], gcov[..., 1])

@@ -1,0 +1,20 @@
+"""Shared helpers for tests that run example files."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from layershell.io.build import build, parse
+from layershell.runner import run
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def run_example(name: str, replace: dict[str, str] | None = None, out=None):
+    """Run ``examples/<name>.toml`` (optionally with text replacements); return the RunResult."""
+    path = EXAMPLES / f"{name}.toml"
+    text = path.read_text()
+    for a, b in (replace or {}).items():
+        assert a in text, f"{a!r} not in {name}.toml"
+        text = text.replace(a, b)
+    spec = build(parse(text, str(path)), path.parent)
+    return run(spec, out, write_vtu=False)
