@@ -63,7 +63,16 @@ def test_export_step_files(solved, tmp_path):
     model, dm, u = solved
     paths = export_step(tmp_path / "out", 3, model, dm, u, 1.0)
     assert paths["surface"].name == "surface_0003.vtu" and paths["solid"].name == "solid_0003.vtu"
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["solid_0003.vtu", "surface_0003.vtu"]
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == [
+        "interface_base_top_0003.vtu", "solid_0003.vtu", "surface_0003.vtu"]
+    import meshio
+
+    itf = meshio.read(paths["interface_base_top"])
+    n = model.mesh.n_elements
+    assert itf.cells[0].type == "quad9" and itf.cells[0].data.shape == (n, 9)
+    assert itf.point_data["traction"].shape == (9 * n, 3) and np.all(np.isfinite(itf.point_data["traction"]))
+    # interface points lie at the top face of the base layer (offset 0.1 along +z)
+    assert np.allclose(itf.points[:, 2], 0.1)
 
     surf = meshio.read(paths["surface"])
     assert [c.type for c in surf.cells] == ["quad9"]

@@ -227,7 +227,32 @@ def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.n
     paths = {"surface": out_dir / f"surface_{step:04d}.vtu", "solid": out_dir / f"solid_{step:04d}.vtu"}
     _write_vtu(paths["surface"], surf)
     _write_vtu(paths["solid"], solid)
+    from .interfaces import interfaces
+
+    for itf in interfaces(model):
+        if itf.elements.size:
+            key = "interface_" + "".join(c if c.isalnum() else "_" for c in itf.name)
+            paths[key] = out_dir / f"{key}_{step:04d}.vtu"
+            _write_vtu(paths[key], interface_mesh(model, dm, u_full, itf))
     return paths
+
+
+def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf):
+    """meshio.Mesh of one interface (quad9 per element, nodes duplicated per element) with the
+    traction components σ13, σ23, σ33 of the upper layer (3.33), the shear resultant and the
+    displacement of the interface."""
+    import meshio
+
+    from .interfaces import interface_state
+
+    ps = interface_state(model, dm, u_full, itf, kind="nodes")
+    t = ps.traction()
+    ne = itf.elements.size
+    return meshio.Mesh(
+        ps.X, [("quad9", np.arange(9 * ne, dtype=np.int64).reshape(ne, 9))],
+        point_data={"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
+                    "shear": np.hypot(t[:, 0], t[:, 1]), "displacement": ps.u},
+        cell_data={"element_id": [itf.elements.astype(np.int64)]})
 
 
 def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
@@ -249,8 +274,15 @@ class PvdWriter:
 
     def __init__(self, out_dir: Path):
         self.out_dir = Path(out_dir)
-        self.surface: list[tuple[float, str]] = []
-        self.solid: list[tuple[float, str]] = []
+        self.series: dict[str, list[tuple[float, str]]] = {"surface": [], "solid": []}
+
+    @property
+    def surface(self) -> list[tuple[float, str]]:
+        return self.series["surface"]
+
+    @property
+    def solid(self) -> list[tuple[float, str]]:
+        return self.series["solid"]
 
     def _rel(self, p: Path) -> str:
         p = Path(p)
@@ -260,14 +292,14 @@ class PvdWriter:
             return p.resolve().as_posix()
 
     def add(self, step: int, load_factor: float, paths: dict[str, Path]) -> None:
-        """Register the files of one step (``paths`` as returned by :func:`export_step`)."""
-        if "surface" in paths:
-            self.surface.append((float(load_factor), self._rel(paths["surface"])))
-        if "solid" in paths:
-            self.solid.append((float(load_factor), self._rel(paths["solid"])))
+        """Register the files of one step (``paths`` as returned by :func:`export_step`); every
+        key becomes a series ``<key>.pvd``."""
+        for key, p in paths.items():
+            self.series.setdefault(key, []).append((float(load_factor), self._rel(p)))
         self.write()
 
     def write(self) -> None:
         self.out_dir.mkdir(parents=True, exist_ok=True)
-        write_pvd(self.out_dir / "surface.pvd", self.surface)
-        write_pvd(self.out_dir / "solid.pvd", self.solid)
+        for key, entries in self.series.items():
+            if entries or key in ("surface", "solid"):
+                write_pvd(self.out_dir / f"{key}.pvd", entries)

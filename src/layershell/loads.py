@@ -140,8 +140,14 @@ def edge_load_vector(model: Model, dm: DofMap, load: EdgeLoad, F: np.ndarray, lo
             ly = model.layers[k]
             off = N @ model.offset(k)[tri]
             H = N @ ly.thickness[tri]
-            q = director_forces_distribution(load.distribution, off, H, ly.directors,
-                                             x=xs[:, 0], y=xs[:, 1], z=xs[:, 2])  # (g, l)
+            if load.at_face is not None:  # line force on a face: (2.175) / (2.180)
+                if k != (stack[-1] if load.at_face == "top" else stack[0]):
+                    continue
+                mag = np.broadcast_to(load.distribution(theta3=off, x=xs[:, 0], y=xs[:, 1], z=xs[:, 2]), H.shape)
+                q = director_vector_face(H, ly.directors, "top" if load.at_face == "top" else "bottom") * mag[:, None]
+            else:
+                q = director_forces_distribution(load.distribution, off, H, ly.directors,
+                                                 x=xs[:, 0], y=xs[:, 1], z=xs[:, 2])  # (g, l)
             val = np.einsum("gn,gl,g,i->nli", N, q, ds, direction)
             _scatter(F, dm.layer_dofs[k][tri], val)
 

@@ -95,6 +95,7 @@ class EdgeLoad:
     direction: np.ndarray
     distribution: object
     scaled: bool = True
+    at_face: str | None = None  # 'top' | 'reference': a line force per edge length on that face (2.180)
 
 
 @dataclass

@@ -4,12 +4,16 @@ Every error is an :class:`InputError` with one paragraph naming the field and th
 """
 from __future__ import annotations
 
+import difflib
+import re
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
+from types import UnionType
+from typing import Annotated, Union, get_args, get_origin
 
 import numpy as np
-from pydantic import ValidationError
+from pydantic import BaseModel, ValidationError
 
 from .. import mesh as meshmod
 from ..element.shape import EDGES
@@ -45,35 +49,160 @@ def _fmt_loc(loc) -> str:
     return out
 
 
+# -- pydantic error locations -> model-file field names ----------------------------------------
+def _members(tp) -> list:
+    """``Annotated``/``Optional``/``Union`` unwrapped into the candidate types."""
+    origin = get_origin(tp)
+    if origin is Annotated:
+        return _members(get_args(tp)[0])
+    if origin in (Union, UnionType):
+        return [m for a in get_args(tp) for m in _members(a)]
+    return [tp]
+
+
+def _models(tp) -> list[type[BaseModel]]:
+    return [m for m in _members(tp) if isinstance(m, type) and issubclass(m, BaseModel)]
+
+
+def _type_tags(tp) -> list[str]:
+    """The ``type = ...`` values of a discriminated union (table kinds such as mesh types)."""
+    tags = []
+    for m in _models(tp):
+        f = m.model_fields.get("type")
+        if f is not None:
+            tags += [a for a in get_args(f.annotation) if isinstance(a, str)]
+    return tags
+
+
+def _resolve_loc(loc) -> tuple[tuple, object]:
+    """Drop pydantic's union-member tags (``'rectangle'``, ``'float'``, ...) from an error location.
+
+    Returns the location as the user wrote it and the schema type found there (None if unknown).
+    """
+    tp: object = schema.ModelFile
+    out: list = []
+    for p in loc:
+        if tp is None:
+            out.append(p)
+            continue
+        models = _models(tp)
+        dicts = [m for m in _members(tp) if get_origin(m) is dict]
+        lists = [m for m in _members(tp) if get_origin(m) is list]
+        field = next((m.model_fields[p] for m in models if isinstance(p, str) and p in m.model_fields), None)
+        if field is not None:
+            out.append(p)
+            tp = field.annotation
+        elif isinstance(p, int) and lists:
+            out.append(p)
+            tp = get_args(lists[0])[0]
+        elif isinstance(p, str) and dicts:
+            out.append(p)
+            tp = get_args(dicts[0])[1]
+        elif isinstance(p, str) and p in _type_tags(tp):  # discriminator tag: the table kind
+            tp = next(m for m in models if p in _type_tags(m))
+        elif isinstance(p, str) and models:  # a key the table does not have (unknown or missing)
+            out.append(p)
+            tp = None
+        # else: the tag of a union member ('float', 'str', 'list[float]', ...): not a field
+    return tuple(out), tp
+
+
+def _suggest(word: str, choices) -> str:
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f"did you mean '{close[0]}'? " if close else ""
+
+
+def _describe_error(err: dict) -> tuple[str, str]:
+    """(field, message with the fix) for one pydantic error."""
+    loc, tp = _resolve_loc(err["loc"])
+    kind = err["type"]
+    msg = err["msg"].removeprefix("Value error, ").removeprefix("Assertion failed, ")
+    inp = err.get("input")
+    got = "" if isinstance(inp, dict) else f" (got {inp!r})"
+    if kind == "extra_forbidden":
+        parent_loc, parent = _resolve_loc(err["loc"][:-1])
+        allowed = [k for m in _models(parent) for k in m.model_fields] if parent is not None else []
+        allowed = list(dict.fromkeys(allowed))
+        hint = _suggest(loc[-1], allowed) if loc else ""
+        where = f"[{_fmt_loc(parent_loc)}]" if parent_loc else "the top level"
+        keys = f"allowed keys in {where}: {', '.join(allowed)}" if allowed else "check the spelling"
+        return _fmt_loc(loc), f"unknown key; {hint}{keys}"
+    if kind == "missing":
+        name = loc[-1] if loc else ""
+        if len(loc) == 1 and name in schema.ModelFile.model_fields:
+            ann = schema.ModelFile.model_fields[name].annotation
+            table = f"[[{name}]]" if get_origin(ann) is list else f"[{name}]"
+            kinds = _type_tags(ann)
+            extra = f" with type = one of {', '.join(repr(t) for t in kinds)} and its parameters" if kinds else ""
+            return _fmt_loc(loc), f"required section is missing; add a {table} table{extra} (see examples/)"
+        parent = _fmt_loc(loc[:-1])
+        return _fmt_loc(loc), f"required key is missing; add '{name} = ...' to [{parent}]"
+    if kind == "union_tag_not_found":
+        tags = _type_tags(tp)
+        return _fmt_loc(loc + ("type",)), ("required key is missing; add type = one of "
+                                           + ", ".join(f"'{t}'" for t in tags))
+    if kind == "union_tag_invalid":
+        tags = _type_tags(tp)
+        tag = err.get("ctx", {}).get("tag", inp.get("type") if isinstance(inp, dict) else inp)
+        return _fmt_loc(loc + ("type",)), (f"unknown type '{tag}'; {_suggest(tag, tags)}use one of "
+                                           + ", ".join(f"'{t}'" for t in tags))
+    if kind in ("value_error", "assertion_error"):
+        return _fmt_loc(loc), msg
+    return _fmt_loc(loc), msg + got
+
+
+def _validation_message(exc: ValidationError, limit: int = 8) -> str:
+    """All errors of ``exc`` as one paragraph: ``'field': message; 'field': message``."""
+    by_field: dict[str, list[str]] = {}
+    for err in exc.errors():
+        field, msg = _describe_error(err)
+        msgs = by_field.setdefault(field, [])
+        if msg not in msgs:
+            msgs.append(msg)
+    parts = []
+    for field, msgs in by_field.items():
+        if len(msgs) > 1 and all(m.startswith("Input should be ") for m in msgs):
+            got = re.search(r" \(got .*\)$", msgs[0])
+            tail = got.group(0) if got and all(m.endswith(got.group(0)) for m in msgs) else ""
+            heads = [m.removeprefix("Input should be ").removesuffix(tail) for m in msgs]
+            text = "Input should be " + " or ".join(heads) + tail
+        else:
+            text = "; ".join(msgs)
+        parts.append(f"'{field}': {text}" if field else text)
+    more = f"; … and {len(parts) - limit} more" if len(parts) > limit else ""
+    return "; ".join(parts[:limit]) + more
+
+
 def parse(text: str, name: str = "model file") -> schema.ModelFile:
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise InputError(f"{name}: not valid TOML: {exc}") from None
+        raise InputError(f"{name}: not valid TOML: {exc}; fix the syntax there (strings need quotes, "
+                         "tables are written [name] or [[name]], one key = value per line)") from None
     try:
         return schema.ModelFile.model_validate(data)
     except ValidationError as exc:
-        lines = []
-        for err in exc.errors()[:8]:
-            loc = _fmt_loc(err["loc"])
-            msg = err["msg"].removeprefix("Value error, ")
-            if err["type"] == "extra_forbidden":
-                msg = "unknown key; check the spelling (see docs/model-file.md for the allowed keys)"
-            elif err["type"] == "missing":
-                msg = "required field is missing"
-            inp = err.get("input")
-            got = f" (got {inp!r})" if err["type"] not in ("missing",) and not isinstance(inp, dict) else ""
-            lines.append(f"'{loc}': {msg}{got}" if loc else f"{msg}")
-        more = f" … and {len(exc.errors()) - 8} more" if len(exc.errors()) > 8 else ""
-        raise InputError(f"{name}: " + "; ".join(lines) + more) from None
+        raise InputError(f"{name}: " + _validation_message(exc)) from None
 
 
 def load(path: str | Path) -> RunSpec:
     path = Path(path)
+    if path.is_dir():
+        raise InputError(f"model file '{path}' is a folder; give the path of a .toml model file")
     if not path.is_file():
-        raise InputError(f"model file '{path}' does not exist")
-    mf = parse(path.read_text(encoding="utf-8"), str(path))
-    spec = build(mf, path.parent)
+        raise InputError(f"model file '{path}' does not exist; check the path (examples are in examples/)")
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise InputError(f"model file '{path}' is not UTF-8 text ({exc.reason} at byte {exc.start}); "
+                         "save it as UTF-8") from None
+    except OSError as exc:
+        raise InputError(f"model file '{path}' cannot be read: {exc.strerror or exc}") from None
+    mf = parse(text, str(path))
+    try:
+        spec = build(mf, path.parent)
+    except InputError as exc:
+        raise InputError(f"{path}: {exc}") from None
     spec.path = path
     return spec
 
