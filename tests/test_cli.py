@@ -3,7 +3,9 @@
 Every case copies an example from ``examples/``, mutates it (through :mod:`tomllib` and the small
 TOML writer below, or as text) and runs the installed ``layershell`` console script in a
 subprocess. The subprocesses are started together (one module fixture), because each one spends
-most of its ~1 s importing NumPy/SciPy; the tests then only inspect the results.
+most of its ~1 s importing NumPy/SciPy; the tests then only inspect the results. To keep the file
+fast, the extra cases beyond the issue's list (``inprocess=True``) call ``layershell.cli.app``
+through typer's CliRunner instead, with the same checks.
 """
 from __future__ import annotations
 
@@ -98,6 +100,7 @@ class Case:
     command: str = "check"
     fields: tuple[str, ...] = ()  # must all appear in the message
     codes: tuple[int, ...] = (2,)
+    inprocess: bool = False  # CliRunner instead of a subprocess (same checks, much faster)
 
 
 def _set(path: str, value):
@@ -142,8 +145,8 @@ CASES: dict[str, Case] = {
                                fields=("layers[0].thickness", "positive")),
     "unknown_key": Case("cantilever_thick.toml", _set("layers.0.thicknes", 1.0),
                         fields=("layers[0].thicknes", "thickness")),
-    "unknown_key_in_mesh": Case("cantilever_thick.toml", _set("mesh.n_x", 5), fields=("mesh.n_x", "nx")),
-    "unknown_section": Case("cantilever_thick.toml", _set("solver", {"tolerance": 1e-8}), fields=("solver",)),
+    "unknown_key_in_mesh": Case("cantilever_thick.toml", _set("mesh.n_x", 5), fields=("mesh.n_x", "nx"), inprocess=True),
+    "unknown_section": Case("cantilever_thick.toml", _set("solver", {"tolerance": 1e-8}), fields=("solver",), inprocess=True),
     "not_positive_definite": Case("cantilever_thick.toml", _set("materials.mat", dict(_BAD_ORTHOTROPIC)),
                                   fields=("materials.mat", "positive definite")),
     "support_selects_no_node": Case("cantilever_thick.toml", _set("supports.1.where", "near(x, 99)"),
@@ -152,63 +155,63 @@ CASES: dict[str, Case] = {
     "thickness_formula_negative": Case("cantilever_thick.toml", _set("layers.0.thickness", "x - 5"),
                                        fields=("layers[0].thickness", "positive")),
     "thickness_formula_bad_variable": Case("cantilever_thick.toml", _set("layers.0.thickness", "1 + t"),
-                                           fields=("layers[0].thickness", "'t'")),
+                                           fields=("layers[0].thickness", "'t'"), inprocess=True),
     # names
     "unknown_material": Case("cantilever_thick.toml", _set("layers.0.material", "steel"),
                              fields=("layers[0].material", "steel", "mat")),
     "unknown_layer_in_support": Case("cantilever_thick.toml", _set("supports.1.layer", "core"),
                                      fields=("supports[1].layer", "core", "beam")),
     "unknown_layer_in_probe": Case("cantilever_thick.toml", _set("probes.0.layer", "core"),
-                                   fields=("probes[0].layer", "core", "beam")),
+                                   fields=("probes[0].layer", "core", "beam"), inprocess=True),
     # formulas
     "formula_import": Case("cantilever_thick.toml", _set("supports.0.where", "__import__('os')"),
                            fields=("supports[0].where", "__import__")),
     "formula_attribute": Case("cantilever_thick.toml", _set("supports.0.where", "x.__class__"),
-                              fields=("supports[0].where", "not allowed")),
+                              fields=("supports[0].where", "not allowed"), inprocess=True),
     "formula_syntax": Case("cantilever_thick.toml", _set("supports.0.where", "near(x, 0"),
                            fields=("supports[0].where", "syntax")),
-    "formula_in_load": Case("ring.toml", _set("loads.0.magnitude", "1 +* x"), fields=("loads[0].magnitude",)),
+    "formula_in_load": Case("ring.toml", _set("loads.0.magnitude", "1 +* x"), fields=("loads[0].magnitude",), inprocess=True),
     "load_not_finite": Case("ring.toml", _set("loads.0.magnitude", "log(x - 100)"),
-                            fields=("loads[0].magnitude", "finite")),
+                            fields=("loads[0].magnitude", "finite"), inprocess=True),
     # types and structure
     "wrong_type_number": Case("cantilever_thick.toml", _set("mesh.lx", "ten"), fields=("mesh.lx", "number")),
     "wrong_type_material": Case("cantilever_thick.toml", _set("materials.mat.E", "big"),
-                                fields=("materials.mat.E",)),
+                                fields=("materials.mat.E",), inprocess=True),
     "wrong_type_list": Case("cantilever_thick.toml", _set("layers.0.thickness", [1.0, 2.0]),
-                            fields=("layers[0].thickness",)),
+                            fields=("layers[0].thickness",), inprocess=True),
     "missing_mesh": Case("cantilever_thick.toml", _delete("mesh"), fields=("mesh", "missing")),
-    "missing_key": Case("cantilever_thick.toml", _delete("mesh.lx"), fields=("mesh.lx", "missing")),
-    "missing_mesh_type": Case("cantilever_thick.toml", _delete("mesh.type"), fields=("mesh.type", "rectangle")),
+    "missing_key": Case("cantilever_thick.toml", _delete("mesh.lx"), fields=("mesh.lx", "missing"), inprocess=True),
+    "missing_mesh_type": Case("cantilever_thick.toml", _delete("mesh.type"), fields=("mesh.type", "rectangle"), inprocess=True),
     "unknown_mesh_type": Case("cantilever_thick.toml", _set("mesh.type", "square"),
-                              fields=("mesh.type", "square", "rectangle")),
+                              fields=("mesh.type", "square", "rectangle"), inprocess=True),
     "unknown_support_type": Case("cantilever_thick.toml", _set("supports.1.type", "clamp"),
-                                 fields=("supports[1].type", "clamp", "fix")),
+                                 fields=("supports[1].type", "clamp", "fix"), inprocess=True),
     "toml_syntax": Case("cantilever_thick.toml", text=lambda t: t.replace("nx = 5", "nx = = 5"),
                         fields=("TOML", "line")),
     "nonexistent_file": Case(None, fields=("does not exist",)),
-    "nonexistent_file_run": Case(None, command="run", fields=("does not exist",)),
+    "nonexistent_file_run": Case(None, command="run", fields=("does not exist",), inprocess=True),
     "mesh_file_missing": Case("cantilever_thick.toml", _set("mesh", {"type": "file", "path": "nowhere.msh"}),
-                              fields=("mesh.path", "nowhere.msh")),
+                              fields=("mesh.path", "nowhere.msh"), inprocess=True),
     # ranges
     "directors_out_of_range": Case("cantilever_thick.toml", _set("layers.0.directors", 5),
                                    fields=("layers[0].directors", "4")),
     "support_director_out_of_range": Case("cantilever_thick.toml", _set("supports.1.directors", [4]),
-                                          fields=("supports[1].directors",)),
+                                          fields=("supports[1].directors",), inprocess=True),
     "poisson_half": Case("cantilever_thick.toml", _set("materials.mat.nu", 0.5), fields=("materials.mat", "nu")),
     "negative_modulus": Case("cantilever_thick.toml", _set("materials.mat.E", -1.0),
-                             fields=("materials.mat", "E")),
+                             fields=("materials.mat", "E"), inprocess=True),
     "probe_component": Case("cantilever_thick.toml", _set("probes.0.component", "w"),
                             fields=("probes[0].component", "'w'", "magnitude")),
     "probe_point_off_surface": Case("ring.toml", _set("probes.0.point", [0.0, 9.0, 1.5]),
-                                    fields=("probes[0].point",)),
+                                    fields=("probes[0].point",), inprocess=True),
     "edge_load_no_edge": Case("cantilever_thick.toml", _set("loads.0.where", "near(x, 10) and near(y, 0)"),
                               fields=("loads[0]", "edge")),
     "edge_load_no_node": Case("cantilever_thick.toml", _set("loads.0.where", "x > 100"),
-                              fields=("loads[0]", "selects no node")),
+                              fields=("loads[0]", "selects no node"), inprocess=True),
     # supports that leave rigid-body motion free
     "no_supports": Case("cantilever_thick.toml", _delete("supports"), fields=("supports", "rigid-body")),
     "no_supports_run": Case("cantilever_thick.toml", _delete("supports"), command="run",
-                            fields=("supports", "rigid-body")),
+                            fields=("supports", "rigid-body"), inprocess=True),
     "rigid_body_mode_run": Case("cantilever_thick.toml", _FREE_IN_Z, command="run",
                                 fields=("supports", "rigid-body"), codes=(1, 2)),
     # bad input also stops `run` before anything is solved
@@ -245,6 +248,25 @@ def _prepare(name: str, case: Case, base: Path) -> list[str]:
     return args
 
 
+def _run_inprocess(args: list[str], out_dir: Path) -> Outcome:
+    from typer.testing import CliRunner
+
+    from layershell.cli import app
+
+    cwd = os.getcwd()
+    os.chdir(out_dir)
+    try:
+        res = CliRunner().invoke(app, args, env={"LAYERSHELL_TRACEBACK": None, "NO_COLOR": "1"})
+    finally:
+        os.chdir(cwd)
+    stderr = res.stderr
+    if res.exception is not None and not isinstance(res.exception, SystemExit):  # would be a traceback
+        import traceback
+
+        stderr += "Traceback:\n" + "".join(traceback.format_exception(res.exception))
+    return Outcome(args, res.exit_code, res.stdout, stderr, out_dir)
+
+
 def _run(args: list[str], out_dir: Path) -> Outcome:
     env = dict(os.environ, NO_COLOR="1", COLUMNS="100", PYTHONIOENCODING="utf-8")
     env.pop("LAYERSHELL_TRACEBACK", None)
@@ -256,13 +278,17 @@ def _run(args: list[str], out_dir: Path) -> Outcome:
 @pytest.fixture(scope="module")
 def outcomes(tmp_path_factory) -> dict[str, Outcome]:
     base = tmp_path_factory.mktemp("cli")
-    jobs = {name: _prepare(name, case, base) for name, case in CASES.items()}
+    jobs = {name: _prepare(name, case, base) for name, case in CASES.items() if not case.inprocess}
     jobs.update({f"check_{g}": ["check", str(EXAMPLES / g)] for g in GOOD})
     good_out = base / "good_run"
     jobs["run_good"] = ["run", str(EXAMPLES / "cantilever_thick.toml"), "--out", str(good_out), "--no-vtu"]
     with ThreadPoolExecutor(max_workers=max(2, min(8, os.cpu_count() or 2))) as pool:
         futures = {name: pool.submit(_run, args, base) for name, args in jobs.items()}
-        return {name: f.result() for name, f in futures.items()}
+        results = {name: f.result() for name, f in futures.items()}
+    for name, case in CASES.items():
+        if case.inprocess:
+            results[name] = _run_inprocess(_prepare(name, case, base), base)
+    return results
 
 
 def _describe(o: Outcome) -> str:

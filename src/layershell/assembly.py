@@ -49,9 +49,19 @@ class Assembler:
     def __init__(self, model: Model, dm: DofMap, chunk: int = 256):
         self.model, self.dm, self.chunk = model, dm, chunk
         self.blocks = build_blocks(model, dm)
-        n = dm.n_full
+        self.extra: list = []
+        self._pattern()
+
+    def add_blocks(self, extra: list) -> None:
+        """Add element-like blocks with ``.dofs (e, m)`` and ``.response(u) -> (f, K)`` (contact)
+        to the sparsity pattern and to every evaluation."""
+        self.extra = list(extra)
+        self._pattern()
+
+    def _pattern(self) -> None:
+        n = self.dm.n_full
         rows, cols = [], []
-        for b in self.blocks:
+        for b in [*self.blocks, *self.extra]:
             m = b.dofs.shape[1]
             rows.append(np.repeat(b.dofs, m, axis=1).ravel())
             cols.append(np.tile(b.dofs, (1, m)).ravel())
@@ -78,6 +88,11 @@ class Assembler:
                 np.add.at(f, b.dofs[sl].ravel(), fe.ravel())
                 if tangent:
                     vals.append(Ke.ravel())
+        for b in self.extra:
+            fe, Ke = b.response(u_full)
+            np.add.at(f, b.dofs.ravel(), fe.ravel())
+            if tangent:
+                vals.append(Ke.ravel())
         if not tangent:
             return f, None
         data = np.bincount(self.scatter, weights=np.concatenate(vals), minlength=self.nnz)

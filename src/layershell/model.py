@@ -113,6 +113,11 @@ class Model:
     n_thickness: int = 3
     nonlinear: bool = True
     units: str = ""
+    # delamination (MODEL.md §9-§10), keyed by the index of the layer above the interface
+    interface_laws: dict = field(default_factory=dict)  # int -> InterfaceLaw
+    initially_debonded: dict = field(default_factory=dict)  # int -> node indices
+    initial_laws: dict = field(default_factory=dict)  # int -> InterfaceLaw of the initial zone
+    delamination: object = None  # DelaminationSettings
 
     def below(self) -> dict[int, int]:
         """Layer index -> index of the layer directly below it (for layers that are not first)."""

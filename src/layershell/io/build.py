@@ -5,8 +5,11 @@ Every error is an :class:`InputError` with one paragraph naming the field and th
 from __future__ import annotations
 
 import difflib
+import importlib.util
+import math
 import re
 import tomllib
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from types import UnionType
@@ -62,6 +65,22 @@ def _members(tp) -> list:
 
 def _models(tp) -> list[type[BaseModel]]:
     return [m for m in _members(tp) if isinstance(m, type) and issubclass(m, BaseModel)]
+
+
+def _item_type(tp):
+    """The table type of a section: the element type of ``list[...]`` / ``dict[str, ...]``, else ``tp``."""
+    for m in _members(tp):
+        if get_origin(m) in (list, dict):
+            return get_args(m)[-1]
+    return tp
+
+
+def _header(section: str) -> str:
+    """How a top-level section is written: ``[mesh]``, ``[[layers]]``, ``[materials.<name>]``."""
+    origins = [get_origin(m) for m in _members(schema.ModelFile.model_fields[section].annotation)]
+    if list in origins:
+        return f"[[{section}]]"
+    return f"[{section}.<name>]" if dict in origins else f"[{section}]"
 
 
 def _type_tags(tp) -> list[str]:
@@ -124,6 +143,10 @@ def _describe_error(err: dict) -> tuple[str, str]:
         allowed = [k for m in _models(parent) for k in m.model_fields] if parent is not None else []
         allowed = list(dict.fromkeys(allowed))
         hint = _suggest(loc[-1], allowed) if loc else ""
+        if not hint and loc and len(parent_loc) == 0:  # a key of a section, written at the top level?
+            homes = [_header(n) for n, f in schema.ModelFile.model_fields.items()
+                     if any(loc[-1] in m.model_fields for m in _models(_item_type(f.annotation)))]
+            hint = f"'{loc[-1]}' is a key of {' or '.join(homes)}; " if homes else ""
         where = f"[{_fmt_loc(parent_loc)}]" if parent_loc else "the top level"
         keys = f"allowed keys in {where}: {', '.join(allowed)}" if allowed else "check the spelling"
         return _fmt_loc(loc), f"unknown key; {hint}{keys}"
@@ -131,10 +154,9 @@ def _describe_error(err: dict) -> tuple[str, str]:
         name = loc[-1] if loc else ""
         if len(loc) == 1 and name in schema.ModelFile.model_fields:
             ann = schema.ModelFile.model_fields[name].annotation
-            table = f"[[{name}]]" if get_origin(ann) is list else f"[{name}]"
-            kinds = _type_tags(ann)
+            kinds = _type_tags(_item_type(ann))
             extra = f" with type = one of {', '.join(repr(t) for t in kinds)} and its parameters" if kinds else ""
-            return _fmt_loc(loc), f"required section is missing; add a {table} table{extra} (see examples/)"
+            return _fmt_loc(loc), f"required section is missing; add a {_header(name)} table{extra} (see examples/)"
         parent = _fmt_loc(loc[:-1])
         return _fmt_loc(loc), f"required key is missing; add '{name} = ...' to [{parent}]"
     if kind == "union_tag_not_found":
@@ -148,6 +170,8 @@ def _describe_error(err: dict) -> tuple[str, str]:
                                            + ", ".join(f"'{t}'" for t in tags))
     if kind in ("value_error", "assertion_error"):
         return _fmt_loc(loc), msg
+    if kind in ("float_parsing", "int_parsing") and inp in ("true", "false"):  # see schema.Strict
+        return _fmt_loc(loc), f"Input should be a number, not the boolean {inp}"
     return _fmt_loc(loc), msg + got
 
 
@@ -264,9 +288,16 @@ def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
         return np.asarray(m.element_sets[set_])
     c = m.nodes[m.elements[:, 8]]
     f = _formula(where, XYZ, f"{field}.where")
-    el = np.flatnonzero(np.broadcast_to(f(tol=1e-6 * m.size(), x=c[:, 0], y=c[:, 1], z=c[:, 2]), (m.n_elements,)))
+    try:
+        el = np.flatnonzero(np.broadcast_to(f(tol=1e-6 * m.size(), x=c[:, 0], y=c[:, 1], z=c[:, 2]),
+                                            (m.n_elements,)))
+    except FormulaError as exc:
+        raise InputError(f"'{field}.where': {exc}") from None
     if el.size == 0:
-        raise InputError(f"'{field}.where': '{where}' selects no element (tested at element centres)")
+        lo, hi = c.min(0), c.max(0)
+        span = ", ".join(f"{n} ∈ [{a:.6g}, {b:.6g}]" for n, a, b in zip(XYZ, lo, hi))
+        raise InputError(f"'{field}.where': '{where}' selects no element (it is tested at the element centres, "
+                         f"which span {span}); widen the condition or use near(x, value)")
     return el
 
 
@@ -286,52 +317,99 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
                                 md.normal, md.axis)
     if md.type == "revolution":
         return meshmod.revolution(md.meridian_r, md.meridian_z, md.n_meridian, md.n_circ, md.angle, md.normal)
-    from .meshfile import read_mesh
-
-    return read_mesh(base / md.path, md.scale)
+    path = base / md.path
+    if not path.is_file():
+        raise InputError(f"'mesh.path': the mesh file '{md.path}' does not exist (looked for {path}); "
+                         "give the path relative to the model file")
+    try:
+        from .meshfile import read_mesh
+    except ImportError as exc:
+        raise InputError(f"'mesh.type': mesh files cannot be read in this installation ({exc}); "
+                         "use a 'rectangle', 'cylinder' or 'revolution' mesh") from None
+    try:
+        return read_mesh(path, md.scale)
+    except (InputError, meshmod.MeshError):
+        raise
+    except Exception as exc:  # meshio's ReadError, KeyError, ... on a broken or unsupported file
+        raise InputError(f"'mesh.path': cannot read '{md.path}' ({type(exc).__name__}: {exc}); give a mesh "
+                         "file of 9-node quadrilaterals that meshio can read (Gmsh .msh, .vtu, ...)") from None
 
 
 def _material(name: str, md) -> Orthotropic:
-    if md.type == "isotropic":
-        mat = Orthotropic.isotropic(md.E, md.nu, md.density, name)
-    elif md.nu31 is not None:
-        mat = Orthotropic(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu31, md.density, name)
-    else:
-        mat = Orthotropic.from_nu13(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu13,
-                                    md.density, name)
+    bad = [k for k, v in md.model_dump().items() if isinstance(v, float) and not math.isfinite(v)]
+    if bad:
+        raise InputError(f"'materials.{name}': {', '.join(bad)} must be {'a finite number' if len(bad) == 1 else 'finite'}"
+                         f" (got {', '.join(f'{k} = {getattr(md, k)}' for k in bad)})")
     try:
+        if md.type == "isotropic":
+            mat = Orthotropic.isotropic(md.E, md.nu, md.density, name)
+        elif md.nu31 is not None:
+            mat = Orthotropic(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu31, md.density,
+                              name)
+        else:
+            mat = Orthotropic.from_nu13(md.E1, md.E2, md.E3, md.G12, md.G23, md.G31, md.nu12, md.nu23, md.nu13,
+                                        md.density, name)
         mat.check()
-    except MaterialError as exc:
+    except (MaterialError, ZeroDivisionError, ArithmeticError) as exc:
         raise InputError(f"'materials.{name}': {exc}") from None
     return mat
+
+
+def _nodal_values(m: meshmod.Mesh, value, field: str, points: np.ndarray | None = None, **extra) -> np.ndarray:
+    """A number or formula evaluated at ``points`` (default: the nodes), as a float array."""
+    x = m.nodes if points is None else points
+    fn = _field_fn(value, field, XYZ + tuple(extra))
+    try:
+        v = fn(x=x[:, 0], y=x[:, 1], z=x[:, 2], **extra)
+        return np.array(np.broadcast_to(v, np.broadcast_shapes(x[:, 0].shape, *(np.shape(e) for e in extra.values()))),
+                        dtype=float)
+    except (FormulaError, ValueError, TypeError) as exc:
+        raise InputError(f"'{field}': cannot evaluate {value!r} ({exc})") from None
+
+
+def _require_finite(vals: np.ndarray, value, field: str, where: str) -> None:
+    if not np.all(np.isfinite(vals)):
+        raise InputError(f"'{field}': {value!r} is not finite (NaN or infinite) at some {where}; "
+                         "give a formula that is defined over the loaded region (check log, sqrt, division)")
 
 
 def _vec(v, field: str) -> np.ndarray:
     a = np.asarray(v, float)
     n = np.linalg.norm(a)
-    if not n > 0:
-        raise InputError(f"'{field}': the direction vector must not be zero")
+    if not (n > 0 and np.isfinite(n)):
+        raise InputError(f"'{field}': the direction vector must not be zero (got {list(v)}); give a non-zero "
+                         "vector [x, y, z]")
     return a / n
 
 
 # ------------------------------------------------------------------ build
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
-        m = _mesh(mf.mesh, base)
-        m.check()
+        with np.errstate(all="ignore"), warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            m = _mesh(mf.mesh, base)
+            m.check()
     except meshmod.MeshError as exc:
         raise InputError(f"'mesh': {exc}") from None
+    except (np.linalg.LinAlgError, ZeroDivisionError, FloatingPointError) as exc:
+        raise InputError(f"'mesh': the mesh is degenerate ({exc}: elements of zero area); check the mesh "
+                         "dimensions") from None
+    if not np.all(np.isfinite(m.nodes)):
+        raise InputError("'mesh': the mesh has nodes with non-finite coordinates; check the mesh dimensions")
     mats = {k: _material(k, v) for k, v in mf.materials.items()}
     names = [ly.name for ly in mf.layers]
     index = {n: i for i, n in enumerate(names)}
     layers = []
     for i, ld in enumerate(mf.layers):
-        fn = _field_fn(ld.thickness, f"layers[{i}].thickness")
-        th = np.broadcast_to(fn(x=m.nodes[:, 0], y=m.nodes[:, 1], z=m.nodes[:, 2]), (m.n_nodes,)).astype(float)
-        if not np.all(th > 0):
+        th = _nodal_values(m, ld.thickness, f"layers[{i}].thickness")
+        if not np.all((th > 0) & np.isfinite(th)):
             bad = np.flatnonzero(~(th > 0))
             raise InputError(f"'layers[{i}].thickness': must be positive at every node, but is {th[bad[0]]:.6g} "
-                             f"at node {bad[0]} {m.nodes[bad[0]].round(6).tolist()} ({bad.size} nodes)")
+                             f"at node {bad[0]} {m.nodes[bad[0]].round(6).tolist()} ({bad.size} of {m.n_nodes} "
+                             "nodes); give a positive number or a formula in x, y, z that is positive over the "
+                             "whole mesh")
+        if ld.direction is not None:
+            _vec(ld.direction, f"layers[{i}].direction")
         layers.append(Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle,
                             tuple(ld.direction) if ld.direction is not None else None))
 
@@ -366,6 +444,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     first = stacks[0][0]
 
     # supports
+    if not mf.supports:
+        raise InputError("'supports': the model has no supports, so it can move as a rigid body; supports must "
+                         "prevent every rigid-body motion (3 translations and 3 rotations): add [[supports]] "
+                         "tables (type = 'fix', 'symmetry' or 'hinge'), see examples/")
     for i, sd in enumerate(mf.supports):
         f = f"supports[{i}]"
         nodes = _node_selection(m, sd, f)
@@ -394,6 +476,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             elif face not in ("reference", "top"):
                 raise InputError(f"'{f}.face': unknown face '{ld.face}'; use 'reference', 'top' or 'layer:<name>'")
             direction = None if ld.direction == "normal" else _vec(ld.direction, f + ".direction")
+            if not isinstance(ld.magnitude, (int, float)):
+                centres = m.nodes[m.elements[el, 8]]
+                _require_finite(_nodal_values(m, ld.magnitude, f + ".magnitude", centres), ld.magnitude,
+                                f + ".magnitude", "loaded element centre")
             model.surface_loads.append(SurfaceLoad(el, face, direction, _field_fn(ld.magnitude, f + ".magnitude"),
                                                    scaled=ld.scaled))
         elif ld.type in ("volume", "gravity"):
@@ -420,9 +506,19 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             mask[nodes] = True
             edges = bedges[mask[bedges].all(1)]
             if edges.size == 0:
-                raise InputError(f"'{f}': the selection picks nodes but no complete boundary edge "
-                                 "(all three nodes of an element edge must be selected)")
+                raise InputError(f"'{f}': the selection '{ld.where or ld.set}' picks {nodes.size} node(s) but no "
+                                 "complete boundary edge; an edge load needs all three nodes of an element edge on "
+                                 "the mesh boundary, e.g. where = \"near(x, 10)\" for the whole edge at x = 10")
             dist = _field_fn(ld.distribution, f + ".distribution", ("t", "x", "y", "z"))
+            if not isinstance(ld.distribution, (int, float)):
+                mid = edges[:, 1]
+                h = model.total_thickness()[mid]
+                frac = (np.arange(4) + 0.5) / 4  # inside the thickness, where the quadrature points lie
+                pts = np.repeat(m.nodes[mid], frac.size, axis=0)
+                t = (h[:, None] * frac[None, :]).ravel()
+                _require_finite(_nodal_values(m, ld.distribution, f + ".distribution", pts, t=t),
+                                ld.distribution, f + ".distribution", "point of the loaded edges (t inside the "
+                                "thickness)")
             model.edge_loads.append(EdgeLoad(edges, _vec(ld.direction, f + ".direction"),
                                              lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled))
         else:  # nodal
@@ -440,6 +536,9 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             raise InputError("'steps.factors': give at least one load factor")
     else:
         lf = st.lambda_end * np.arange(1, st.n + 1) / st.n
+    if st.solver == "pardiso" and importlib.util.find_spec("pypardiso") is None:
+        raise InputError("'steps.solver': 'pardiso' needs the optional package pypardiso (pip install "
+                         "'layershell[fast]'); install it or use solver = 'auto' or 'superlu'")
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
                             max_bisections=st.max_bisections, backend=st.solver)
     from .probes import build_probes

@@ -87,7 +87,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         k = None
         if pd.layer is not None:
             if pd.layer not in layer_index:
-                raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'")
+                raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'; defined: {list(layer_index)}")
             k = layer_index[pd.layer]
         comp = pd.component
         allowed = {"displacement": ("x", "y", "z", "magnitude"),

@@ -6,7 +6,8 @@ parser :mod:`layershell.formula`, never ``eval``.
 """
 from __future__ import annotations
 
-from typing import Annotated, Literal, Union
+import math
+from typing import Annotated, Literal, Union, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, field_validator, model_validator
 
@@ -14,8 +15,28 @@ Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NumOrFormula = Union[float, str]
 
 
+def _leaf_types(tp) -> set:
+    args = get_args(tp)
+    return {tp} if not args else set().union(*(_leaf_types(a) for a in args))
+
+
 class Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
+
+    @model_validator(mode="before")
+    @classmethod
+    def _no_boolean_numbers(cls, data):
+        """TOML true/false only where a yes/no is meant: pydantic would read true as the number 1.
+
+        The boolean is handed on as the text 'true'/'false', so that the error names the field.
+        """
+        if isinstance(data, dict):
+            for k, v in data.items():
+                if isinstance(v, bool) and k in cls.model_fields:
+                    leaves = _leaf_types(cls.model_fields[k].annotation)
+                    if bool not in leaves and leaves & {int, float}:
+                        data = {**data, k: str(v).lower()}
+        return data
 
 
 # ------------------------------------------------------------------ general settings
@@ -50,6 +71,14 @@ class CylinderMesh(Strict):
         "inward", description="'inward': reference face outside (A3 towards the axis)")
     axis: Literal["z", "y"] = "z"
 
+    @model_validator(mode="after")
+    def _span(self):
+        span = abs(self.angle_end - self.angle_start)
+        if not 0 < span <= 360:
+            raise ValueError(f"angle_end - angle_start must be non-zero and at most 360 degrees in magnitude (got "
+                             f"angle_start = {self.angle_start}, angle_end = {self.angle_end})")
+        return self
+
 
 class RevolutionMesh(Strict):
     type: Literal["revolution"]
@@ -63,7 +92,14 @@ class RevolutionMesh(Strict):
     @model_validator(mode="after")
     def _same_length(self):
         if len(self.meridian_r) != len(self.meridian_z):
-            raise ValueError("meridian_r and meridian_z must have the same length")
+            raise ValueError(f"meridian_r and meridian_z must have the same length (got {len(self.meridian_r)} "
+                             f"and {len(self.meridian_z)}); give one (r, z) pair per meridian point")
+        if any(r < 0 for r in self.meridian_r):
+            raise ValueError(f"meridian_r must not be negative (got {self.meridian_r}); r is the distance from the axis")
+        pts = list(zip(self.meridian_r, self.meridian_z))
+        if any(a == b for a, b in zip(pts, pts[1:])):
+            raise ValueError("consecutive meridian points (meridian_r[i], meridian_z[i]) must differ; remove the "
+                             "repeated point")
         return self
 
 
@@ -81,7 +117,7 @@ class Isotropic(Strict):
     type: Literal["isotropic"]
     E: float
     nu: float
-    density: float = 0.0
+    density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
 
 class OrthotropicMat(Strict):
@@ -96,12 +132,13 @@ class OrthotropicMat(Strict):
     nu23: float
     nu31: float | None = None
     nu13: float | None = Field(None, description="give nu13 instead of nu31 (nu31 = nu13 E3/E1)")
-    density: float = 0.0
+    density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
     @model_validator(mode="after")
     def _one_of(self):
         if (self.nu31 is None) == (self.nu13 is None):
-            raise ValueError("give exactly one of nu31 and nu13")
+            raise ValueError("give exactly one of nu31 and nu13 (nu31 = nu13 E3/E1)"
+                             + (", not both" if self.nu31 is not None else ""))
         return self
 
 
@@ -119,8 +156,9 @@ class LayerDef(Strict):
     @field_validator("thickness")
     @classmethod
     def _positive(cls, v):
-        if isinstance(v, (int, float)) and not v > 0:
-            raise ValueError(f"thickness must be positive (got {v})")
+        if isinstance(v, (int, float)) and not (v > 0 and math.isfinite(v)):
+            raise ValueError(f"must be positive and finite (got {v}); give the layer thickness as a positive "
+                             "number or a formula in x, y, z")
         return v
 
 
@@ -267,13 +305,15 @@ class ModelFile(Strict):
         names = [ly.name for ly in self.layers]
         dup = {n for n in names if names.count(n) > 1}
         if dup:
-            raise ValueError(f"layer names must be unique: {sorted(dup)}")
+            raise ValueError(f"'layers': layer names must be unique, but {sorted(dup)} appear more than once; "
+                             "rename the layers")
         for i, ly in enumerate(self.layers):
             if ly.material not in self.materials:
-                raise ValueError(f"layers[{i}].material: unknown material '{ly.material}'; "
-                                 f"defined: {sorted(self.materials)}")
+                raise ValueError(f"'layers[{i}].material': unknown material '{ly.material}'; defined: "
+                                 f"{sorted(self.materials)} (fix the name or add a [materials.{ly.material}] table)")
         pn = [p.name for p in self.probes]
         dup = {n for n in pn if pn.count(n) > 1}
         if dup:
-            raise ValueError(f"probe names must be unique: {sorted(dup)}")
+            raise ValueError(f"'probes': probe names must be unique, but {sorted(dup)} appear more than once; "
+                             "rename the probes")
         return self

@@ -21,18 +21,29 @@ class Problem:
     F_scaled: np.ndarray
     F_const: np.ndarray
     bonded: dict[int, np.ndarray] = field(default_factory=dict)
+    F_friction: np.ndarray | None = None
+    extra_blocks: list = field(default_factory=list)
+    interfaces: object = None  # InterfaceController when the model has interface laws
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
         dm = number_dofs(model)
         below = model.below()
         bonded = {up: dm.present[up] & dm.present[lo] for up, lo in below.items()}
-        op = constraint_operator(model, dm, bonded)
         Fs, Fc = external_forces(model, dm)
-        return cls(model, dm, Assembler(model, dm), op, Fs, Fc, bonded)
+        pb = cls(model, dm, Assembler(model, dm), None, Fs, Fc, bonded)
+        if model.interface_laws:
+            from .interface_state import InterfaceController
+
+            pb.interfaces = InterfaceController.build(pb, model.interface_laws, model.initially_debonded,
+                                                      model.initial_laws, model.delamination)
+            pb.assembler.add_blocks(pb.extra_blocks)
+        pb.rebuild_constraints()
+        return pb
 
     def rebuild_constraints(self) -> None:
         self.op = constraint_operator(self.model, self.dm, self.bonded)
 
     def external(self, lam: float) -> np.ndarray:
-        return lam * self.F_scaled + self.F_const
+        F = lam * self.F_scaled + self.F_const
+        return F if self.F_friction is None else F + self.F_friction

@@ -1,0 +1,108 @@
+"""Inner contact between a debonded layer and the layer below, MODEL.md §10 / thesis (4.37)-(4.59).
+
+Points are the 9 face Gauss points of the upper layer (the "integration points of layer L",
+(3.48)); each belongs to the region of its nearest node (§9 rule 1) and is released when that
+node is released at this interface. Pairing is along the common undeformed normal A3 of S1
+(no search, (4.37)-(4.38)). With nodal thicknesses (exact at nodes, A6) the relative
+displacement of the upper layer's bottom face to the lower layer's top face is
+
+    Δu(q) = Σ_n N_n(q) (u_0L,n - Σ_l H_(L-1),n^l u_l(L-1),n)         (4.43)-(4.44)
+
+and the normal gap ḡ_N = Δu · A3 (4.45). Penalty contact acts where ḡ_N ≤ 0 with the energy
+½ α_N ḡ_N² per area: f = α_N ḡ_N ∂ḡ/∂u, K = α_N ∂ḡ/∂u ⊗ ∂ḡ/∂u (4.56)-(4.59); the gap is linear
+in u, so there is no second-order term.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .dofs import DofMap
+from .element.geometry import shell_basis, surface_points
+from .element.quadrature import gauss_2d
+from .element.shape import NODE_XI
+from .interfaces import Interface
+from .model import Model
+
+
+def point_regions() -> np.ndarray:
+    """Element node (VTK order) whose region contains each 3×3 face Gauss point (§9 rule 1:
+    the nearest node)."""
+    pts, _ = gauss_2d(3)
+    sgn = np.sign(np.round(pts, 12))
+    return np.array([int(np.flatnonzero((NODE_XI == s).all(1))[0]) for s in sgn])
+
+
+@dataclass
+class ContactBlock:
+    """Reference data and state of the contact of one interface over its elements.
+
+    dofs (e, m): [upper u_0 (9 × 3), lower u_l (9 × (d+1) × 3)] full-space DOFs
+    C (e, q, 3, m): Δu_i = C_iM U_M;  b (e, q, m): ∂ḡ_N/∂U = A3 · C
+    w (e, q): contact weights μ(Ĥ) √A κ;  w0 (e, q): load weights √A κ (μ neglected, (4.74))
+    released (e, q): region released (set by the interface state); alpha: penalty α_N
+    """
+
+    itf: Interface
+    conn: np.ndarray
+    dofs: np.ndarray
+    C: np.ndarray
+    b: np.ndarray
+    A3: np.ndarray
+    w: np.ndarray
+    w0: np.ndarray
+    region: np.ndarray  # (q,) node of each point
+    alpha: float
+    released: np.ndarray
+
+    @classmethod
+    def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float) -> "ContactBlock":
+        el = itf.elements
+        conn = model.mesh.elements[el]
+        pts, wq = gauss_2d(3)
+        sp = surface_points(model.mesh.nodes[conn], pts[:, 0], pts[:, 1])
+        lo = model.layers[itf.lower]
+        d = lo.directors
+        H = lo.thickness[conn]  # (e, 9) nodal thickness of the lower layer
+        off = model.offset(itf.upper)[conn]
+        _, _, detG = shell_basis(sp, sp.interpolate(off)[..., None])
+        ne, nq = len(el), len(wq)
+        m = 27 + 27 * (d + 1)
+        C = np.zeros((ne, nq, 3, m))
+        eye = np.eye(3)
+        up = np.einsum("qn,ij->qinj", sp.N, eye).reshape(nq, 3, 27)
+        C[:, :, :, :27] = up[None]
+        lo_c = -np.einsum("qn,enl,ij->eqinlj", sp.N, H[..., None] ** np.arange(d + 1), eye)
+        C[:, :, :, 27:] = lo_c.reshape(ne, nq, 3, -1)
+        b = np.einsum("eqi,eqim->eqm", sp.A3, C)
+        dofs = np.concatenate([dm.layer_dofs[itf.upper][conn][:, :, 0, :].reshape(ne, -1),
+                               dm.layer_dofs[itf.lower][conn].reshape(ne, -1)], axis=1)
+        return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(), alpha,
+                   np.zeros((ne, nq), bool))
+
+    # ------------------------------------------------------------------ kinematics
+    def relative_displacement(self, u_full: np.ndarray) -> np.ndarray:
+        """Δu (e, q, 3) of the upper layer's bottom face relative to the lower layer's top face."""
+        return np.einsum("eqim,em->eqi", self.C, u_full[self.dofs])
+
+    def gap(self, u_full: np.ndarray) -> np.ndarray:
+        """Normal gap ḡ_N (e, q) along the undeformed normal (4.43)."""
+        return np.einsum("eqm,em->eq", self.b, u_full[self.dofs])
+
+    # ------------------------------------------------------------------ assembly
+    def response(self, u_full: np.ndarray):
+        """Penalty contact force (e, m) and tangent (e, m, m) at released, closed points."""
+        g = self.gap(u_full)
+        active = self.released & (g <= 0.0)
+        a = self.alpha * self.w * active
+        f = np.einsum("eq,eqm->em", a * g, self.b)
+        K = np.einsum("eq,eqm,eqn->emn", a, self.b, self.b)
+        return f, K
+
+    def load_vector(self, traction: np.ndarray, F: np.ndarray) -> None:
+        """Add the director forces of an interface traction τ' (e, q, 3) (force of the upper layer
+        on the lower one, per area): the lower layer's top face gets +τ', the upper layer's
+        bottom face -τ' (4.74)-(4.75)."""
+        fe = -np.einsum("eq,eqim,eqi->em", self.w0, self.C, traction)
+        np.add.at(F, self.dofs.ravel(), fe.ravel())

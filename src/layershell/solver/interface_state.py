@@ -1,0 +1,179 @@
+"""Delamination and friction state update after each converged load step, MODEL.md §9-§10.
+
+Per step (thesis (4.22)-(4.85), with the re-equilibration the spec recommends):
+  1. Newton at the new load level with penalty contact (consistent tangent) and the friction
+     loads of the last converged state (explicit, as in the thesis);
+  2. ``update``: g_T^max ← max(g_T^max, |g_T|) at released points; the failure function V at
+     bonded points; failed points release their nearest node at this interface, in every
+     element sharing it (irreversible); the bond matrix is rebuilt; newly released points get
+     the return-mapped shear (4.71)-(4.75) as friction load;
+  3. while something new failed: solve the same load level again.
+Friction loads of sliding points: |τ'| = τ^Gleit_max(g_T^max, σ33) along the slip direction
+(4.76)-(4.78), σ33 the contact pressure; none where the gap is open.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..contact import ContactBlock
+from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_slide
+from ..interfaces import Interface, interface_state, interfaces
+
+
+@dataclass
+class InterfaceRun:
+    block: ContactBlock
+    law: InterfaceLaw
+    law_initial: InterfaceLaw
+    initial: np.ndarray  # (e, q) points in an initially debonded zone
+    gmax: np.ndarray  # (e, q) history variable g_T^max
+    tau: np.ndarray  # (e, q, 3) friction load τ' (force of the upper on the lower layer per area)
+    fresh: np.ndarray  # (e, q) released in the last update, still on the return-mapped load
+    V: np.ndarray  # (e, q) failure function at the last update (nan where released)
+    gap: np.ndarray  # (e, q)
+    slip: np.ndarray  # (e, q, 3) tangential relative displacement g_T
+    pressure: np.ndarray  # (e, q) contact pressure (≤ 0)
+    first_failure: float | None = None
+
+
+@dataclass
+class DelaminationSettings:
+    max_release: int | None = None  # nodes released per re-solution (largest V first)
+    max_resolves: int = 100
+    friction: str = "explicit"
+
+
+@dataclass
+class InterfaceController:
+    """Owns the interface states of a :class:`~layershell.solver.problem.Problem`."""
+
+    runs: list[InterfaceRun]
+    settings: DelaminationSettings = field(default_factory=DelaminationSettings)
+    resolves: int = 0  # re-solutions in the current step
+    lam: float = 0.0
+
+    # ------------------------------------------------------------------ set-up
+    @classmethod
+    def build(cls, problem, laws: dict[int, InterfaceLaw], initial: dict[int, np.ndarray],
+              initial_laws: dict[int, InterfaceLaw], settings: DelaminationSettings | None = None):
+        model, dm = problem.model, problem.dm
+        runs = []
+        for itf in interfaces(model):
+            if itf.upper not in laws or itf.elements.size == 0:
+                continue
+            law = laws[itf.upper]
+            alpha = law.alpha_N if law.alpha_N is not None else _default_penalty(model, itf)
+            blk = ContactBlock.build(model, dm, itf, alpha)
+            ne, nq = blk.w.shape
+            init_nodes = np.zeros(model.mesh.n_nodes, bool)
+            if itf.upper in initial:
+                init_nodes[initial[itf.upper]] = True
+                problem.bonded[itf.upper] = problem.bonded[itf.upper] & ~init_nodes
+            ini = init_nodes[blk.conn[:, blk.region]]
+            z = np.zeros((ne, nq))
+            runs.append(InterfaceRun(blk, law, initial_laws.get(itf.upper, law), ini, z.copy(),
+                                     np.zeros((ne, nq, 3)), np.zeros((ne, nq), bool), np.full((ne, nq), np.nan),
+                                     z.copy(), np.zeros((ne, nq, 3)), z.copy()))
+        ctl = cls(runs, settings or DelaminationSettings())
+        problem.extra_blocks = [r.block for r in runs]
+        ctl.sync(problem)
+        return ctl
+
+    def sync(self, problem) -> None:
+        """Released flags of the contact points from the nodal bond state; friction load vector."""
+        for r in self.runs:
+            r.block.released = ~problem.bonded[r.block.itf.upper][r.block.conn[:, r.block.region]]
+        F = np.zeros(problem.dm.n_full)
+        for r in self.runs:
+            r.block.load_vector(r.tau * r.block.released[..., None], F)
+        problem.F_friction = F
+
+    # ------------------------------------------------------------------ per step
+    def begin_step(self) -> None:
+        self.resolves = 0
+
+    def update(self, problem, u: np.ndarray, lam: float) -> bool:
+        """After a converged solution: history, failures, release, friction. True = re-solve."""
+        self.lam = lam
+        model, dm = problem.model, problem.dm
+        new_any = False
+        for r in self.runs:
+            blk, itf = r.block, r.block.itf
+            ne, nq = blk.w.shape
+            ps = interface_state(model, dm, u, itf, "gauss")
+            t = ps.traction().reshape(ne, nq, 3)
+            m = ps.m.reshape(ne, nq, 3, 3)
+            rel = blk.released
+            # --- slip, gap, pressure, history at released points
+            du = blk.relative_displacement(u)
+            n = m[..., 2, :]
+            gT = du - np.einsum("eqi,eqi->eq", du, n)[..., None] * n
+            g = np.einsum("eqi,eqi->eq", du, blk.A3)
+            r.gap, r.slip = g, gT
+            r.pressure = np.where(rel & (g < 0), blk.alpha * g, 0.0)
+            gabs = np.linalg.norm(gT, axis=-1)
+            r.gmax = np.where(rel & ~r.fresh, np.maximum(r.gmax, gabs), r.gmax)
+            # --- friction loads of sliding points (explicit: used in the next solution)
+            H_up = model.layers[itf.upper].thickness[blk.conn].mean(1)[:, None]
+            open_gap = (r.law.open_gap if r.law.open_gap is not None else 1e-3 * H_up)
+            cap = np.where(r.initial, tau_slide(r.pressure, r.gmax, r.law_initial), tau_slide(r.pressure, r.gmax, r.law))
+            tiny = 1e-12 * model.mesh.size()
+            has_dir = gabs > tiny
+            direction = np.where(has_dir[..., None], gT / np.where(has_dir, gabs, 1.0)[..., None], 0.0)
+            old = np.linalg.norm(r.tau, axis=-1)
+            keep_dir = ~has_dir & (old > 0)  # no slip yet: keep the return-mapped direction
+            direction = np.where(keep_dir[..., None], r.tau / np.where(old > 0, old, 1.0)[..., None], direction)
+            sliding = rel & ~r.fresh
+            r.tau = np.where((sliding & (g <= open_gap))[..., None], cap[..., None] * direction,
+                             np.where(sliding[..., None], 0.0, r.tau))
+            r.fresh[:] = False
+            # --- failure at bonded points (4.15)-(4.16)
+            V, failed = failure_function(t, r.law)
+            r.V = np.where(rel, np.nan, V)
+            cand = failed & ~rel
+            if not cand.any():
+                continue
+            e_i, q_i = np.nonzero(cand)
+            nodes = blk.conn[e_i, blk.region[q_i]]
+            score = np.where(np.isfinite(V[e_i, q_i]), V[e_i, q_i], np.inf)
+            order = np.argsort(-score, kind="stable")
+            uniq = list(dict.fromkeys(nodes[order].tolist()))
+            if self.settings.max_release:
+                uniq = uniq[: self.settings.max_release]
+            problem.bonded[itf.upper][np.asarray(uniq)] = False
+            if r.first_failure is None:
+                r.first_failure = lam
+            now = ~problem.bonded[itf.upper][blk.conn[:, blk.region]]
+            new = now & ~rel
+            # --- return mapping at fracture (4.71)-(4.75): shear part as friction load
+            tm = return_map_at_fracture(t, r.law)
+            tau_rm = tm[..., 0, None] * m[..., 0, :] + tm[..., 1, None] * m[..., 1, :]
+            r.tau = np.where(new[..., None], tau_rm, r.tau)
+            r.fresh = new
+            new_any = True
+        if new_any:
+            problem.rebuild_constraints()
+            self.resolves += 1
+        self.sync(problem)
+        if self.resolves > self.settings.max_resolves:
+            raise RuntimeError(f"more than {self.settings.max_resolves} re-solutions at load factor {lam:.6g}; "
+                               "the debonding does not stabilise (unstable delamination)")
+        return new_any
+
+    # ------------------------------------------------------------------ results
+    def first_failure(self) -> float | None:
+        vals = [r.first_failure for r in self.runs if r.first_failure is not None]
+        return min(vals) if vals else None
+
+    def debonded_area(self) -> dict[str, float]:
+        return {r.block.itf.name: float((r.block.w0 * r.block.released).sum()) for r in self.runs}
+
+
+def _default_penalty(model, itf: Interface) -> float:
+    """α_N = 100 E3,max / H_min of the two layers (MODEL.md §10: try 10²-10³ E/H_min)."""
+    lo, up = model.layers[itf.lower], model.layers[itf.upper]
+    E = max(lo.material.E3, up.material.E3)
+    H = min(lo.thickness.min(), up.thickness.min())
+    return 100.0 * E / H
