@@ -25,6 +25,9 @@ from .element.shape import NODE_XI
 from .interfaces import Interface
 from .model import Model
 
+#: exponent n of the smooth friction regularisation f(x) = x/(1 + x^n)^(1/n) (f(1) = 0.917, f(2) = 0.9997)
+FRICTION_SHARPNESS = 8.0
+
 
 def point_regions() -> np.ndarray:
     """Element node (VTK order) whose region contains each 3×3 face Gauss point (§9 rule 1:
@@ -55,6 +58,12 @@ class ContactBlock:
     region: np.ndarray  # (q,) node of each point
     alpha: float
     released: np.ndarray
+    active: np.ndarray | None = None  # frozen contact set during a Newton solve (None: from the gap)
+    # penalty-regularised friction (return mapping): None = friction only as external loads
+    alpha_T: float | None = None
+    cap: np.ndarray | None = None  # (e, q) slip limit of the current step (0: no friction)
+    t_n: np.ndarray | None = None  # (e, q, 3) converged tangential traction (upper on lower)
+    g_p: np.ndarray | None = None  # (e, q, 3) slip anchor: t = α_T (P Δu - g_p) while sticking
 
     @classmethod
     def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float) -> "ContactBlock":
@@ -91,13 +100,62 @@ class ContactBlock:
         return np.einsum("eqm,em->eq", self.b, u_full[self.dofs])
 
     # ------------------------------------------------------------------ assembly
+    def freeze(self, u_full: np.ndarray) -> None:
+        """Fix the contact set (released points with ḡ_N ≤ 0) and the stick/slip states for the
+        following iterations."""
+        self.active = None
+        self.active = self.released & (self.gap(u_full) <= 0.0)
+
+    def set_changed(self, u_full: np.ndarray) -> bool:
+        """After convergence with frozen states: do they still match the solution (no released
+        point penetrates outside the contact set, none in it is pulled open, stick points stay
+        below the slip limit, sliding points still push against it)?"""
+        want = self.released & (self.gap(u_full) <= 0.0)
+        return bool(np.any(want != (self.active if self.active is not None else want)))
+
+    def unfreeze(self) -> None:
+        self.active = None
+
+    def projector(self) -> np.ndarray:
+        """P = I - A3 ⊗ A3: tangential part along the undeformed normal, (e, q, 3, 3)."""
+        return np.eye(3) - np.einsum("eqi,eqj->eqij", self.A3, self.A3)
+
+    def friction_traction(self, u_full: np.ndarray):
+        """Penalty-regularised friction: with the trial t_tr = α_T (P Δu - g_p) the traction is
+        t = cap f(|t_tr|/cap) t_tr/|t_tr|, f(x) = x/(1 + x^n)^(1/n) (n = FRICTION_SHARPNESS): a
+        smooth stand-in for the rigid-plastic return mapping (stick stiffness α_T below the
+        limit, the slip limit cap beyond; an addition to the thesis, which applies friction as
+        loads). Returns t (e, q, 3) (force of the upper layer on the lower one per area) and
+        dt/dΔu (e, q, 3, 3) (symmetric)."""
+        P = self.projector()
+        gT = np.einsum("eqij,eqj->eqi", P, self.relative_displacement(u_full))
+        t_tr = self.alpha_T * (gT - self.g_p)
+        n = np.linalg.norm(t_tr, axis=-1)
+        on = self.released & (self.cap > 0)
+        cap = np.where(on, self.cap, 1.0)
+        x = n / cap
+        k = FRICTION_SHARPNESS
+        den = (1.0 + x**k) ** (1.0 / k)
+        f_over_x = 1.0 / den  # f(x)/x
+        fprime = (1.0 + x**k) ** (-1.0 / k - 1.0)  # f'(x)
+        e = t_tr / np.where(n > 0, n, 1.0)[..., None]
+        ee = np.einsum("eqi,eqj->eqij", e, e)
+        dtdtr = f_over_x[..., None, None] * (np.eye(3) - ee) + fprime[..., None, None] * ee
+        D = self.alpha_T * np.einsum("eqij,eqjk->eqik", dtdtr, P) * on[..., None, None]
+        return t_tr * (f_over_x * on)[..., None], D
+
     def response(self, u_full: np.ndarray):
-        """Penalty contact force (e, m) and tangent (e, m, m) at released, closed points."""
+        """Penalty contact (and, with return-mapping friction, the tangential traction): internal
+        force (e, m) and tangent (e, m, m) at released points."""
         g = self.gap(u_full)
-        active = self.released & (g <= 0.0)
+        active = self.released & (g <= 0.0) if self.active is None else self.active & self.released
         a = self.alpha * self.w * active
         f = np.einsum("eq,eqm->em", a * g, self.b)
         K = np.einsum("eq,eqm,eqn->emn", a, self.b, self.b)
+        if self.alpha_T is not None and self.cap is not None:
+            t, D = self.friction_traction(u_full)
+            f += np.einsum("eq,eqim,eqi->em", self.w0, self.C, t)
+            K += np.einsum("eq,eqim,eqij,eqjn->emn", self.w0, self.C, D, self.C, optimize=True)
         return f, K
 
     def load_vector(self, traction: np.ndarray, F: np.ndarray) -> None:

@@ -8,8 +8,15 @@ Per step (thesis (4.22)-(4.85), with the re-equilibration the spec recommends):
      element sharing it (irreversible); the bond matrix is rebuilt; newly released points get
      the return-mapped shear (4.71)-(4.75) as friction load;
   3. while something new failed: solve the same load level again.
-Friction loads of sliding points: |τ'| = τ^Gleit_max(g_T^max, σ33) along the slip direction
-(4.76)-(4.78), σ33 the contact pressure; none where the gap is open.
+Friction (``DelaminationSettings.friction``):
+  * ``"return_mapping"`` (default): a penalty-regularised stick/slip law whose slip limit is the
+    thesis's τ^Gleit_max(g_T^max, σ33) (4.76)-(4.78), (4.84), frozen within a step; direction and
+    stick are implicit with a consistent tangent (the standard penalty-Coulomb return mapping
+    MODEL.md §10 recommends). Right after fracture the stick anchor is set so that the point
+    transmits exactly the return-mapped shear (4.71)-(4.75).
+  * ``"explicit"`` (the thesis's treatment): |τ'| = τ^Gleit_max along the last slip direction,
+    applied as external loads without stiffness, updated after every converged solution.
+In both, σ33 is the contact pressure and there is no friction where the gap is open.
 """
 from __future__ import annotations
 
@@ -17,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..contact import ContactBlock
+from ..contact import FRICTION_SHARPNESS, ContactBlock
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
 
@@ -42,7 +49,7 @@ class InterfaceRun:
 class DelaminationSettings:
     max_release: int | None = None  # nodes released per re-solution (largest V first)
     max_resolves: int = 100
-    friction: str = "explicit"
+    friction: str = "return_mapping"  # or "explicit"
 
 
 @dataclass
@@ -67,11 +74,16 @@ class InterfaceController:
             alpha = law.alpha_N if law.alpha_N is not None else _default_penalty(model, itf)
             blk = ContactBlock.build(model, dm, itf, alpha)
             ne, nq = blk.w.shape
+            if (settings or DelaminationSettings()).friction == "return_mapping":
+                blk.alpha_T = law.alpha_T if law.alpha_T is not None else alpha
+                blk.cap, blk.t_n, blk.g_p = np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3))
             init_nodes = np.zeros(model.mesh.n_nodes, bool)
             if itf.upper in initial:
                 init_nodes[initial[itf.upper]] = True
                 problem.bonded[itf.upper] = problem.bonded[itf.upper] & ~init_nodes
             ini = init_nodes[blk.conn[:, blk.region]]
+            if blk.cap is not None:  # initial zones start in contact with g_T^max = 0
+                blk.cap = np.where(ini, tau_slide(0.0, 0.0, initial_laws.get(itf.upper, law)), 0.0)
             z = np.zeros((ne, nq))
             runs.append(InterfaceRun(blk, law, initial_laws.get(itf.upper, law), ini, z.copy(),
                                      np.zeros((ne, nq, 3)), np.zeros((ne, nq), bool), np.full((ne, nq), np.nan),
@@ -87,7 +99,8 @@ class InterfaceController:
             r.block.released = ~problem.bonded[r.block.itf.upper][r.block.conn[:, r.block.region]]
         F = np.zeros(problem.dm.n_full)
         for r in self.runs:
-            r.block.load_vector(r.tau * r.block.released[..., None], F)
+            if r.block.alpha_T is None:  # explicit friction: external loads
+                r.block.load_vector(r.tau * r.block.released[..., None], F)
         problem.F_friction = F
 
     # ------------------------------------------------------------------ per step
@@ -115,19 +128,38 @@ class InterfaceController:
             r.pressure = np.where(rel & (g < 0), blk.alpha * g, 0.0)
             gabs = np.linalg.norm(gT, axis=-1)
             r.gmax = np.where(rel & ~r.fresh, np.maximum(r.gmax, gabs), r.gmax)
-            # --- friction loads of sliding points (explicit: used in the next solution)
             H_up = model.layers[itf.upper].thickness[blk.conn].mean(1)[:, None]
             open_gap = (r.law.open_gap if r.law.open_gap is not None else 1e-3 * H_up)
-            cap = np.where(r.initial, tau_slide(r.pressure, r.gmax, r.law_initial), tau_slide(r.pressure, r.gmax, r.law))
-            tiny = 1e-12 * model.mesh.size()
-            has_dir = gabs > tiny
-            direction = np.where(has_dir[..., None], gT / np.where(has_dir, gabs, 1.0)[..., None], 0.0)
-            old = np.linalg.norm(r.tau, axis=-1)
-            keep_dir = ~has_dir & (old > 0)  # no slip yet: keep the return-mapped direction
-            direction = np.where(keep_dir[..., None], r.tau / np.where(old > 0, old, 1.0)[..., None], direction)
-            sliding = rel & ~r.fresh
-            r.tau = np.where((sliding & (g <= open_gap))[..., None], cap[..., None] * direction,
-                             np.where(sliding[..., None], 0.0, r.tau))
+            closed = g <= open_gap
+            law_cap = np.where(r.initial, tau_slide(r.pressure, r.gmax, r.law_initial),
+                               tau_slide(r.pressure, r.gmax, r.law))
+            if blk.alpha_T is not None:
+                # --- return mapping: commit the converged traction, new slip limit for the next solve
+                t_conv, _ = blk.friction_traction(u)
+                P = blk.projector()
+                gTu = np.einsum("eqij,eqj->eqi", P, du)
+                # keep the trial where it is (the anchor g_p only moves with the limit): the committed
+                # traction is re-expressed on the new limit so that t stays continuous
+                blk.t_n = np.where(rel[..., None], t_conv, 0.0)
+                newcap = np.where(rel & closed, law_cap, 0.0)
+                tn = np.linalg.norm(t_conv, axis=-1)
+                ratio = np.clip(tn / np.where(newcap > 0, newcap, 1.0), 0.0, 0.999)
+                x = ratio / (1.0 - ratio**FRICTION_SHARPNESS) ** (1.0 / FRICTION_SHARPNESS)  # f(x) = ratio
+                e = t_conv / np.where(tn > 0, tn, 1.0)[..., None]
+                blk.g_p = np.where(rel[..., None], gTu - (x * newcap)[..., None] * e / blk.alpha_T, 0.0)
+                blk.cap = newcap
+                r.tau = blk.t_n
+            else:
+                # --- explicit loads of sliding points, used in the next solution
+                tiny = 1e-12 * model.mesh.size()
+                has_dir = gabs > tiny
+                direction = np.where(has_dir[..., None], gT / np.where(has_dir, gabs, 1.0)[..., None], 0.0)
+                old = np.linalg.norm(r.tau, axis=-1)
+                keep_dir = ~has_dir & (old > 0)  # no slip yet: keep the return-mapped direction
+                direction = np.where(keep_dir[..., None], r.tau / np.where(old > 0, old, 1.0)[..., None], direction)
+                sliding = rel & ~r.fresh
+                r.tau = np.where((sliding & closed)[..., None], law_cap[..., None] * direction,
+                                 np.where(sliding[..., None], 0.0, r.tau))
             r.fresh[:] = False
             # --- failure at bonded points (4.15)-(4.16)
             V, failed = failure_function(t, r.law)
@@ -152,6 +184,12 @@ class InterfaceController:
             tau_rm = tm[..., 0, None] * m[..., 0, :] + tm[..., 1, None] * m[..., 1, :]
             r.tau = np.where(new[..., None], tau_rm, r.tau)
             r.fresh = new
+            if blk.alpha_T is not None:  # anchor so that the point transmits the mapped shear (×0.999)
+                gTu = np.einsum("eqij,eqj->eqi", blk.projector(), du)
+                x0 = (1.0 / (1.0 - 0.999 ** FRICTION_SHARPNESS) - 1.0) ** (-1.0 / FRICTION_SHARPNESS)  # f(x0) = 0.999
+                blk.t_n = np.where(new[..., None], 0.999 * tau_rm, blk.t_n)
+                blk.g_p = np.where(new[..., None], gTu - x0 * tau_rm / blk.alpha_T, blk.g_p)
+                blk.cap = np.where(new, np.linalg.norm(tau_rm, axis=-1), blk.cap)
             new_any = True
         if new_any:
             problem.rebuild_constraints()

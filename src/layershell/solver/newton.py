@@ -25,6 +25,9 @@ class NewtonSettings:
     max_iterations: int = 25
     max_bisections: int = 8
     backend: str = "auto"
+    max_active_set_loops: int = 12
+    line_search: bool = True
+    max_line_search: int = 8
 
 
 @dataclass
@@ -56,6 +59,34 @@ class ConvergenceError(RuntimeError):
 
 
 def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
+    """Equilibrium at load factor ``lam`` from ``u``; with contact, an active-set loop around
+    :func:`newton_fixed_set` (the contact set is frozen during the iterations, then checked)."""
+    blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
+    if not blocks:
+        return newton_fixed_set(problem, u, lam, s)
+    total = NewtonResult(False, 0)
+    for _ in range(s.max_active_set_loops):
+        for b in blocks:
+            b.freeze(u)
+        u_new, res = newton_fixed_set(problem, u, lam, s)
+        total.iterations += res.iterations
+        total.residuals += res.residuals
+        total.message = res.message
+        if not res.converged:
+            break
+        u = u_new
+        if not any(b.set_changed(u) for b in blocks):
+            total.converged = True
+            break
+    else:
+        total.converged = True  # the set cycles between equivalent states: accept the last
+        total.message = "contact set still changing after the allowed active-set loops"
+    for b in blocks:
+        b.unfreeze()
+    return u, total
+
+
+def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
     """Equilibrium iterations at fixed load factor ``lam`` starting from ``u`` (full space)."""
     op = problem.op
     Fext = problem.external(lam)
@@ -87,10 +118,29 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             return u + dU, res
+        if s.line_search and problem.model.nonlinear:
+            dU = _line_search(problem, u, dU, Fext, rn, s)
         u = u + dU
     res.iterations = s.max_iterations
     res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
     return u, res
+
+
+def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
+                 s: NewtonSettings) -> np.ndarray:
+    """Backtracking on the residual norm: the full Newton step unless it increases the residual
+    (then halve it, at most ``max_line_search`` times, keeping the best)."""
+    op = problem.op
+    best, best_r, eta = dU, np.inf, 1.0
+    for _ in range(s.max_line_search):
+        f, _ = problem.assembler.evaluate(u + eta * dU, tangent=False)
+        r = float(np.linalg.norm(op.reduce(Fext - f)))
+        if r < best_r:
+            best, best_r = eta * dU, r
+        if r <= (1.0 - 1e-4 * eta) * rn:
+            return eta * dU
+        eta *= 0.5
+    return best
 
 
 def load_steps(
