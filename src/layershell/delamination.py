@@ -17,8 +17,8 @@ class InterfaceLaw:
     sigma_max, tau_max, p: failure surface (4.15)-(4.21); mu0, mu, gT_mu: adhesive slip-
     softening friction (4.70)-(4.78) (``gT_mu = inf``: constant μ0 τ_Delam); mu_coulomb: Coulomb
     fallback (4.84); alpha_N: normal contact penalty (None: 100 E_3,max / H_min); alpha_T: stick
-    penalty of the Coulomb law (None: alpha_N); open_gap: a gap larger than this counts as open
-    (no friction; None: 1e-3 × the upper layer's thickness).
+    penalty of the regularised friction (None: G_13/H of the thinner layer); open_gap: a gap larger than this counts as open
+    (no friction; None: 0.1 × the upper layer's thickness).
     """
 
     sigma_max: float

@@ -14,6 +14,59 @@ from .solver.newton import ConvergenceError, load_steps
 from .solver.problem import Problem
 
 
+def through_thickness(spec_profile, model, dm, u):
+    """Stress component along the thickness at a point: {layer name: (Θ³, values)}."""
+    from .io.probes import STRESS_COMPONENTS
+    from .results import evaluate_points, locate
+
+    pr = spec_profile
+    e, x, y, _ = locate(model, pr.point)
+    conn = model.mesh.elements[e]
+    out = {}
+    from .element.shape import quad9
+
+    N, _, _ = quad9(np.array([x]), np.array([y]))
+    for k in model.stacks[model.element_stack[e]]:
+        H = float(N[0] @ model.layers[k].thickness[conn])
+        off = float(N[0] @ model.offset(k)[conn])
+        thL = np.linspace(0.0, H, pr.points_per_layer)
+        ps = evaluate_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True)
+        T = ps.cauchy_physical if pr.measure == "cauchy" else ps.pk2_physical
+        c = pr.component
+        if c in STRESS_COMPONENTS:
+            i, j = STRESS_COMPONENTS[c]
+            v = T[:, i, j]
+        elif c in ("p1", "p2", "p3"):
+            v = np.linalg.eigvalsh(T)[:, ::-1][:, int(c[1]) - 1]
+        else:
+            dev = T - np.trace(T, axis1=1, axis2=2)[:, None, None] / 3 * np.eye(3)
+            v = np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
+        out[model.layers[k].name] = (off + thL, v)
+    return out
+
+
+def write_profiles(spec, problem, u, out: Path) -> dict:
+    """profile_<name>.csv (Θ³ and one column per layer) and profile_<name>.png."""
+    from .io.output import write_csv
+
+    files = {}
+    for pr in spec.profiles:
+        cols = through_thickness(pr, spec.model, problem.dm, u)
+        names = list(cols)
+        rows = []
+        for i, n in enumerate(names):
+            th, v = cols[n]
+            for t, val in zip(th, v):
+                rows.append([float(t)] + [float(val) if j == i else "" for j in range(len(names))])
+        write_csv(out / f"profile_{pr.name}.csv", ["theta3"] + names, rows)
+        files[pr.name] = f"profile_{pr.name}.csv"
+        if spec.output.plots:
+            from .plots import plot_through_thickness
+
+            plot_through_thickness(out / f"profile_{pr.name}.png", cols, f"{pr.measure} {pr.component}")
+    return files
+
+
 @dataclass
 class RunResult:
     converged: bool
@@ -58,12 +111,36 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     u = np.zeros(problem.dm.n_full)
     message = ""
     n_steps = len(spec.load_factors)
+    ctl = problem.interfaces
+    if ctl is not None:
+        summary["first_delamination_load_factor"] = None
+        summary["debonded_area"] = []
+    resolves = {"n": 0}
+
+    def on_step_end(pb, uu, lam):
+        again = ctl.update(pb, uu, lam)
+        resolves["n"] += int(again)
+        return again
+
     try:
-        for st in load_steps(problem, spec.load_factors, spec.newton):
+        for st in load_steps(problem, spec.load_factors, spec.newton,
+                             on_step_end=on_step_end if ctl is not None else None):
             u = st.u
             vals = {p.name: p.value(model, problem.dm, u) for p in spec.probes}
             rec = {"step": st.step, "load_factor": st.load_factor, "iterations": st.iterations,
                    "bisections": st.bisections, "wall_seconds": round(st.wall_seconds, 4), "probes": vals}
+            from .interfaces import traction_summary
+
+            itf = traction_summary(model, problem.dm, u)
+            if itf:
+                rec["interfaces"] = itf
+            if ctl is not None:
+                rec["resolves"] = resolves["n"]
+                resolves["n"] = 0
+                rec["debonded_area"] = ctl.debonded_area()
+                summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,
+                                                 **rec["debonded_area"]})
+                summary["first_delamination_load_factor"] = ctl.first_failure()
             summary["steps"].append(rec)
             summary["probes"] = vals
             rows.append([st.step, st.load_factor, st.iterations] + [vals[n] for n in names])
@@ -86,6 +163,8 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
         message = "interrupted by the user; the converged steps are kept"
         summary["error"] = message
     summary["wall_seconds"] = round(time.perf_counter() - t0, 4)
+    if out is not None and spec.profiles and summary["steps"]:
+        summary["profiles"] = write_profiles(spec, problem, u, out)
     if out is not None:
         write_json(out / "summary.json", summary)
         write_csv(out / "probes.csv", ["step", "load_factor", "iterations"] + names, rows)

@@ -10,7 +10,7 @@ import math
 import re
 import tomllib
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from types import UnionType
 from typing import Annotated, Union, get_args, get_origin
@@ -40,6 +40,7 @@ class RunSpec:
     output: schema.OutputDef
     source: schema.ModelFile
     path: Path | None = None
+    profiles: list = field(default_factory=list)
 
 
 XYZ = ("x", "y", "z")
@@ -383,6 +384,91 @@ def _vec(v, field: str) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ build
+def _edge_normals(m: meshmod.Mesh, nodes: np.ndarray, field: str) -> np.ndarray:
+    """In-plane unit normal of the boundary edge through each node: A3 × edge tangent."""
+    from ..element.shape import line3
+
+    be = boundary_edges(m)
+    lookup = {}
+    for e, conn in enumerate(m.elements):
+        for tri in EDGES:
+            lookup[(conn[tri[0]], conn[tri[1]], conn[tri[2]])] = e
+    out = np.zeros((len(nodes), 3))
+    pos = {int(n): i for i, n in enumerate(nodes)}
+    found = np.zeros(len(nodes), bool)
+    for tri in be:
+        for k, node in enumerate(tri):
+            i = pos.get(int(node))
+            if i is None or found[i]:
+                continue
+            s = np.array([-1.0, 0.0, 1.0])[k]
+            _, dN = line3(np.array([s]))
+            t = dN[0] @ m.nodes[tri]
+            e = lookup.get(tuple(int(v) for v in tri), lookup.get(tuple(int(v) for v in tri[::-1])))
+            c = m.nodes[m.elements[e]]
+            n3 = np.cross(c[1] - c[0], c[3] - c[0])
+            v = np.cross(n3, t)
+            out[i] = v / np.linalg.norm(v)
+            found[i] = True
+    if not found.all():
+        raise InputError(f"'{field}.direction': 'edge-normal' needs nodes on the mesh boundary; "
+                         f"{int((~found).sum())} selected node(s) are not on a boundary edge")
+    return out
+
+
+def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
+    """Interface laws, initially debonded zones and delamination settings (MODEL.md §9-§10)."""
+    from ..delamination import InterfaceLaw
+    from ..solver.interface_state import DelaminationSettings
+
+    if not mf.interfaces:
+        return
+    below = model.below()
+    m = model.mesh
+    for i, idf in enumerate(mf.interfaces):
+        f = f"interfaces[{i}]"
+        if idf.layer not in index:
+            raise InputError(f"'{f}.layer': unknown layer '{idf.layer}'; defined: {list(index)}")
+        k = index[idf.layer]
+        if k not in below:
+            raise InputError(f"'{f}.layer': layer '{idf.layer}' lies directly on the reference face in every "
+                             "stack, so it has no interface below it; name the upper layer of the interface")
+        if k in model.interface_laws:
+            raise InputError(f"'{f}.layer': the interface below '{idf.layer}' is defined twice")
+        gT = float("inf") if idf.gT_mu == "inf" else float(idf.gT_mu)
+        law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
+                           idf.alpha_N, idf.alpha_T)
+        try:
+            law.check(f)
+        except ValueError as exc:
+            raise InputError(str(exc)) from None
+        model.interface_laws[k] = law
+        nodes = []
+        zone_law = None
+        for j, z in enumerate(idf.initially_debonded):
+            fz = f"{f}.initially_debonded[{j}]"
+            if z.circle is not None:
+                c = np.asarray(z.circle[:-1], float)
+                r = z.circle[-1]
+                d = np.linalg.norm(m.nodes[:, : c.size] - c, axis=1)
+                sel = np.flatnonzero(d <= r * (1 + 1e-9))
+                if sel.size == 0:
+                    raise InputError(f"'{fz}.circle': the circle {z.circle} contains no node")
+            else:
+                sel = _node_selection(m, z, fz)
+            nodes.append(sel)
+            if any(v is not None for v in (z.mu0, z.mu, z.gT_mu)):
+                gz = gT if z.gT_mu is None else (float("inf") if z.gT_mu == "inf" else float(z.gT_mu))
+                zone_law = InterfaceLaw(law.sigma_max, law.tau_max, law.p, law.mu0 if z.mu0 is None else z.mu0,
+                                        law.mu if z.mu is None else z.mu, gz, law.mu_coulomb, law.alpha_N, law.alpha_T)
+        if nodes:
+            model.initially_debonded[k] = np.unique(np.concatenate(nodes))
+            if zone_law is not None:
+                model.initial_laws[k] = zone_law
+    d = mf.delamination
+    model.delamination = DelaminationSettings(d.max_release, d.max_resolves, d.friction)
+
+
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -462,8 +548,12 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         elif sd.type == "symmetry":
             model.symmetries.append(Symmetry(nodes, _vec(sd.normal, f + ".normal")))
         else:
-            model.hinges.append(Hinge(nodes, np.tile(_vec(sd.direction, f + ".direction"), (len(nodes), 1)),
-                                      None if sd.height is None else np.full(len(nodes), sd.height), sd.fixed))
+            if sd.direction == "edge-normal":
+                dirs = _edge_normals(m, nodes, f)
+            else:
+                dirs = np.tile(_vec(sd.direction, f + ".direction"), (len(nodes), 1))
+            model.hinges.append(Hinge(nodes, dirs, None if sd.height is None else np.full(len(nodes), sd.height),
+                                      sd.fixed))
     # loads
     bedges = None
     for i, ld in enumerate(mf.loads):
@@ -520,7 +610,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                                 ld.distribution, f + ".distribution", "point of the loaded edges (t inside the "
                                 "thickness)")
             model.edge_loads.append(EdgeLoad(edges, _vec(ld.direction, f + ".direction"),
-                                             lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled))
+                                             lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled,
+                                             at_face=ld.face))
         else:  # nodal
             nodes = _node_selection(m, ld, f)
             k = layer_idx(ld.layer, f + ".layer")
@@ -541,7 +632,16 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                          "'layershell[fast]'); install it or use solver = 'auto' or 'superlu'")
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
                             max_bisections=st.max_bisections, backend=st.solver)
+    _interfaces(mf, model, index, layers)
     from .probes import build_probes
 
     probes = build_probes(mf, model, index, _node_selection)
-    return RunSpec(model, lf, newton, probes, mf.output, mf)
+    for i, pr in enumerate(mf.profiles):
+        from .probes import STRESS_COMPONENTS
+
+        if pr.component not in (*STRESS_COMPONENTS, "p1", "p2", "p3", "von_mises"):
+            raise InputError(f"'profiles[{i}].component': '{pr.component}' is not a stress component; use one of "
+                             f"{[*STRESS_COMPONENTS, 'p1', 'p2', 'p3', 'von_mises']}")
+    spec = RunSpec(model, lf, newton, probes, mf.output, mf)
+    spec.profiles = list(mf.profiles)
+    return spec

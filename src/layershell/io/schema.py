@@ -195,7 +195,9 @@ class HingeDef(Strict):
     where: str | None = None
     set: str | None = None
     point: Vec3 | None = None
-    direction: Vec3 = Field(description="hinge direction (global), not the thickness direction")
+    direction: Union[Vec3, Literal["edge-normal"]] = Field(
+        description="hinge direction: a global vector (not the thickness direction) or 'edge-normal', the in-plane "
+                    "normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
     height: float | None = Field(None, description="Θ³ of the hinge; default mid-thickness")
     fixed: bool = Field(True, description="fixed hinge (u0 of the first layer along 'direction' only) or sliding")
 
@@ -220,7 +222,10 @@ class EdgeLoadDef(Strict):
     set: str | None = None
     direction: Vec3
     distribution: NumOrFormula = Field(
-        description="traction per area through the thickness: formula in t (Θ³ from the reference face), x, y, z")
+        description="traction per area through the thickness: formula in t (Θ³ from the reference face), x, y, z; "
+                    "with 'face': a line force per edge length on that face")
+    face: Literal["top", "reference"] | None = Field(
+        None, description="apply a line force on the edge of the top (opposite) or reference face, (2.175)/(2.180)")
     scaled: bool = True
 
 
@@ -282,6 +287,51 @@ class ProbeDef(Strict):
     scale: float = 1.0
 
 
+class ProfileDef(Strict):
+    """Stress along the thickness at a point, one CSV column per layer, and a PNG plot."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    point: Vec3 = Field(description="point on the reference surface")
+    component: str = Field("11", description="11|22|33|23|13|12|p1|p2|p3|von_mises")
+    measure: Literal["cauchy", "pk2"] = "cauchy"
+    points_per_layer: int = Field(21, ge=2, le=1001)
+
+
+class InitialZone(Strict):
+    """Initially debonded region of an interface: nodes selected by a formula, a set, or a circle."""
+
+    where: str | None = None
+    set: str | None = None
+    circle: Annotated[list[float], Field(min_length=3, max_length=4)] | None = Field(
+        None, description="[x, y, radius] (or [x, y, z, radius]) on the reference surface")
+    mu0: float | None = Field(None, ge=0, le=1, description="friction in the zone (default: the interface's)")
+    mu: float | None = Field(None, gt=0, le=1)
+    gT_mu: Union[PositiveFloat, Literal["inf"]] | None = None
+
+
+class InterfaceDef(Strict):
+    """Interface below layer ``layer`` (MODEL.md §9-§10)."""
+
+    layer: str = Field(description="the layer above the interface")
+    sigma_max: PositiveFloat = Field(description="tensile strength σ33_max (4.15)")
+    tau_max: PositiveFloat = Field(description="shear strength τ_max (4.15)")
+    p: float = Field(2.0, ge=1.0, description="exponent of the failure surface (4.19)")
+    mu0: float = Field(0.95, ge=0, le=1, description="friction right after fracture (4.70)")
+    mu: float = Field(0.2, gt=0, le=1, description="residual friction ratio at g_T = gT_mu (4.77)")
+    gT_mu: Union[PositiveFloat, Literal["inf"]] = Field("inf", description="slip of the residual friction (4.76)")
+    mu_coulomb: float = Field(0.0, ge=0, description="Coulomb coefficient of the fallback (4.84)")
+    alpha_N: PositiveFloat | None = Field(None, description="normal contact penalty (default 100 E3/H_min)")
+    alpha_T: PositiveFloat | None = Field(None, description="tangential stick penalty (default alpha_N)")
+    initially_debonded: list[InitialZone] = []
+
+
+class DelaminationDef(Strict):
+    friction: Literal["return_mapping", "explicit"] = Field(
+        "return_mapping", description="friction as a regularised return mapping, or as explicit loads (thesis)")
+    max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
+    max_resolves: PositiveInt = 100
+
+
 class OutputDef(Strict):
     vtu: bool = True
     plots: bool = True
@@ -298,6 +348,9 @@ class ModelFile(Strict):
     loads: list[Load] = []
     steps: Steps = Steps()
     probes: list[ProbeDef] = []
+    profiles: list[ProfileDef] = []
+    interfaces: list[InterfaceDef] = []
+    delamination: DelaminationDef = DelaminationDef()
     output: OutputDef = OutputDef()
 
     @model_validator(mode="after")

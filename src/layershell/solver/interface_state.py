@@ -75,7 +75,7 @@ class InterfaceController:
             blk = ContactBlock.build(model, dm, itf, alpha)
             ne, nq = blk.w.shape
             if (settings or DelaminationSettings()).friction == "return_mapping":
-                blk.alpha_T = law.alpha_T if law.alpha_T is not None else alpha
+                blk.alpha_T = law.alpha_T if law.alpha_T is not None else _default_stick(model, itf)
                 blk.cap, blk.t_n, blk.g_p = np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3))
             init_nodes = np.zeros(model.mesh.n_nodes, bool)
             if itf.upper in initial:
@@ -129,7 +129,7 @@ class InterfaceController:
             gabs = np.linalg.norm(gT, axis=-1)
             r.gmax = np.where(rel & ~r.fresh, np.maximum(r.gmax, gabs), r.gmax)
             H_up = model.layers[itf.upper].thickness[blk.conn].mean(1)[:, None]
-            open_gap = (r.law.open_gap if r.law.open_gap is not None else 1e-3 * H_up)
+            open_gap = (r.law.open_gap if r.law.open_gap is not None else 0.1 * H_up)
             closed = g <= open_gap
             law_cap = np.where(r.initial, tau_slide(r.pressure, r.gmax, r.law_initial),
                                tau_slide(r.pressure, r.gmax, r.law))
@@ -207,6 +207,15 @@ class InterfaceController:
 
     def debonded_area(self) -> dict[str, float]:
         return {r.block.itf.name: float((r.block.w0 * r.block.released).sum()) for r in self.runs}
+
+
+def _default_stick(model, itf: Interface) -> float:
+    """α_T = G_13 / H of the thinner layer: the shear stiffness of that layer per area. Stiffer
+    stick penalties make the regularised friction effectively rigid-plastic, and Newton then
+    struggles at stick/slip transitions (V5 results are unchanged between 1e8 and 1e9)."""
+    lo, up = model.layers[itf.lower], model.layers[itf.upper]
+    thin = lo if lo.thickness.min() < up.thickness.min() else up
+    return min(thin.material.G31, thin.material.G23) / thin.thickness.min()
 
 
 def _default_penalty(model, itf: Interface) -> float:

@@ -118,7 +118,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             return u + dU, res
-        if s.line_search and problem.model.nonlinear:
+        if s.line_search and problem.assembler.extra:  # contact: non-smooth, globalise
             dU = _line_search(problem, u, dU, Fext, rn, s)
         u = u + dU
     res.iterations = s.max_iterations
@@ -128,19 +128,18 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
 
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
                  s: NewtonSettings) -> np.ndarray:
-    """Backtracking on the residual norm: the full Newton step unless it increases the residual
-    (then halve it, at most ``max_line_search`` times, keeping the best)."""
+    """Backtracking on the residual norm: the full Newton step unless it increases the residual;
+    then halve it (at most ``max_line_search`` times) until the residual decreases. If no step
+    length helps, the full step is kept (Newton may still recover)."""
     op = problem.op
-    best, best_r, eta = dU, np.inf, 1.0
+    eta = 1.0
     for _ in range(s.max_line_search):
         f, _ = problem.assembler.evaluate(u + eta * dU, tangent=False)
         r = float(np.linalg.norm(op.reduce(Fext - f)))
-        if r < best_r:
-            best, best_r = eta * dU, r
-        if r <= (1.0 - 1e-4 * eta) * rn:
+        if r <= rn:
             return eta * dU
         eta *= 0.5
-    return best
+    return dU
 
 
 def load_steps(

@@ -1,0 +1,50 @@
+"""Issue 3 #2: the locking study of thesis Fig. 3.13 (MODEL.md V3)."""
+import sys
+from pathlib import Path
+
+import pytest
+from helpers import run_example
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import locking_study  # noqa: E402
+
+
+def rel(a, b):
+    return abs(a - b) / abs(b)
+
+
+def test_thick_example_matches_the_elastica():
+    """3 layers × 3 directors, geometrically nonlinear: 3.449 cm against the exact elastica 3.490
+    (P l²/EI = 1.2) — within 2 %. The thesis's 3.899 cm is 12 % above the elastica and cannot
+    be the result of a conservative end load; it is close to the linear value (4.012)."""
+    w = run_example("cantilever_thick_load_bottom").summary["probes"]["w_tip"]
+    assert rel(w, 3.490) < 0.02
+    assert rel(w, 3.899) > 0.1
+
+
+def test_thin_linear_matches_the_thesis_value():
+    """Thin beam, 3 × 3: the geometrically linear deflection (8.786) equals the thesis's 8.790 to
+    0.1 %; both are 2.4 % below Euler-Bernoulli (9.0) — the 9-node element's mild locking over
+    20 cm elements of 0.333 cm depth, as the thesis says."""
+    w = locking_study.w_tip("thin", 3, 3, nonlinear=False)
+    assert rel(w, 8.790) < 0.001
+
+
+@pytest.mark.parametrize("case", ["thick", "thin"])
+def test_deflection_grows_towards_the_reference_with_layers_and_directors(case):
+    """Fig. 3.13 trend (linear runs, fast): more layers at d = 1 and more directors in one layer
+    both reduce the locking; d = 2 is the most effective step."""
+    by_layers = [locking_study.w_tip(case, n, 1, nonlinear=False) for n in (1, 2, 3)]
+    by_dirs = [locking_study.w_tip(case, 1, d, nonlinear=False) for d in (1, 2, 3)]
+    assert by_layers[0] < by_layers[1] < by_layers[2]
+    assert by_dirs[0] < by_dirs[1] <= by_dirs[2] * (1 + 1e-9)
+    assert (by_dirs[1] - by_dirs[0]) > 10 * (by_dirs[2] - by_dirs[1])
+
+
+@pytest.mark.slow
+def test_thin_example_nonlinear_membrane_locking():
+    """Thin beam, nonlinear, 3 × 3: 7.64 cm, 14 % below the elastica (8.926): five quadratic
+    elements over l/h = 300 lock in large rotation ("larger loads or slenderness quickly ruin
+    results", thesis 3.5.1). Documented, not hidden."""
+    w = run_example("cantilever_thin_load_bottom").summary["probes"]["w_tip"]
+    assert 7.5 < w < 7.8
