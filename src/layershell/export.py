@@ -211,7 +211,7 @@ def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
 
 
 def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.ndarray,
-                load_factor: float) -> dict[str, Path]:
+                load_factor: float, controller=None) -> dict[str, Path]:
     """Write ``surface_{step:04d}.vtu`` and ``solid_{step:04d}.vtu`` into ``out_dir``.
 
     Returns ``{"surface": path, "solid": path}``. ``load_factor`` is not stored in the files
@@ -233,11 +233,14 @@ def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.n
         if itf.elements.size:
             key = "interface_" + "".join(c if c.isalnum() else "_" for c in itf.name)
             paths[key] = out_dir / f"{key}_{step:04d}.vtu"
-            _write_vtu(paths[key], interface_mesh(model, dm, u_full, itf))
+            run = None
+            if controller is not None:
+                run = next((r for r in controller.runs if r.block.itf.upper == itf.upper), None)
+            _write_vtu(paths[key], interface_mesh(model, dm, u_full, itf, run))
     return paths
 
 
-def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf):
+def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None):
     """meshio.Mesh of one interface (quad9 per element, nodes duplicated per element) with the
     traction components σ13, σ23, σ33 of the upper layer (3.33), the shear resultant and the
     displacement of the interface."""
@@ -248,11 +251,25 @@ def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf):
     ps = interface_state(model, dm, u_full, itf, kind="nodes")
     t = ps.traction()
     ne = itf.elements.size
-    return meshio.Mesh(
-        ps.X, [("quad9", np.arange(9 * ne, dtype=np.int64).reshape(ne, 9))],
-        point_data={"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
-                    "shear": np.hypot(t[:, 0], t[:, 1]), "displacement": ps.u},
-        cell_data={"element_id": [itf.elements.astype(np.int64)]})
+    point_data = {"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
+                  "shear": np.hypot(t[:, 0], t[:, 1]), "displacement": ps.u}
+    if run is not None:
+        # delamination state lives at the 9 face Gauss points; each belongs to exactly one node
+        # region (MODEL.md §9 rule 1), so it maps one-to-one onto the element's nodes
+        inv = np.argsort(run.block.region)
+        pick = lambda a: a[:, inv].reshape(ne * 9, *a.shape[2:])  # noqa: E731
+        point_data.update({
+            "debonded": pick(run.block.released.astype(np.int8)),
+            "failure_V": pick(np.nan_to_num(run.V, nan=0.0)),
+            "contact_pressure": pick(run.pressure),
+            "gap": pick(run.gap),
+            "slip": pick(run.slip),
+            "slip_magnitude": pick(np.linalg.norm(run.slip, axis=-1)),
+            "gT_max": pick(run.gmax),
+            "friction_shear": pick(np.linalg.norm(run.tau, axis=-1) * run.block.released),
+        })
+    return meshio.Mesh(ps.X, [("quad9", np.arange(9 * ne, dtype=np.int64).reshape(ne, 9))],
+                       point_data=point_data, cell_data={"element_id": [itf.elements.astype(np.int64)]})
 
 
 def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:

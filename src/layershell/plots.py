@@ -157,3 +157,42 @@ def plot_through_thickness(path, columns: dict[str, tuple[np.ndarray, np.ndarray
         ax.legend(fontsize="small")
     fig.tight_layout()
     return _save(fig, path)
+
+
+def plot_debonded_zone(path, controller, title: str = "") -> Path:
+    """Plan view of every interface: face Gauss points (the "integration points of layer L")
+    bonded (grey) or debonded (red), sized by their area; one panel per interface."""
+    runs = controller.runs
+    fig = _figure((5.0 * max(len(runs), 1), 4.6))
+    for i, r in enumerate(runs):
+        ax = fig.add_subplot(1, max(len(runs), 1), i + 1)
+        from .element.geometry import surface_points
+        from .element.quadrature import gauss_2d
+
+        pts, _ = gauss_2d(3)
+        blk = r.block
+        X = surface_points(controller.mesh_nodes[blk.conn], pts[:, 0], pts[:, 1]).X0
+        rel = blk.released.ravel()
+        w = blk.w0.ravel()
+        s = 400.0 * w / w.max()
+        ax.scatter(X[..., 0].ravel()[~rel], X[..., 1].ravel()[~rel], s=s[~rel], c="0.75", label="bonded")
+        ax.scatter(X[..., 0].ravel()[rel], X[..., 1].ravel()[rel], s=s[rel], c="tab:red", label="debonded")
+        ax.set_aspect("equal")
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        ax.set_title(f"{blk.itf.name} {title}".strip())
+        ax.legend(loc="upper right", fontsize=8)
+    return _save(fig, path)
+
+
+def plot_load_vs_area(path, load_factors, areas: dict[str, list[float]], units: str = "") -> Path:
+    """Load factor against the debonded area of every interface."""
+    fig = _figure((6.0, 4.2))
+    ax = fig.add_subplot(1, 1, 1)
+    for name, a in areas.items():
+        ax.plot(a, load_factors, "o-", label=name)
+    ax.set_xlabel(f"debonded area{f' [{units}]' if units else ''}")
+    ax.set_ylabel("load factor λ")
+    ax.grid(True, alpha=0.3)
+    ax.legend()
+    return _save(fig, path)

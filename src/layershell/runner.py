@@ -63,7 +63,8 @@ def write_profiles(spec, problem, u, out: Path) -> dict:
         if spec.output.plots:
             from .plots import plot_through_thickness
 
-            plot_through_thickness(out / f"profile_{pr.name}.png", cols, f"{pr.measure} {pr.component}")
+            plot_through_thickness(out / f"profile_{pr.name}.png", {k: (v, t) for k, (t, v) in cols.items()},
+                                   f"{pr.measure} σ{pr.component}")
     return files
 
 
@@ -148,7 +149,7 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                 if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
                     from .export import export_step
 
-                    paths = export_step(out, st.step, model, problem.dm, u, st.load_factor)
+                    paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl)
                     pvd.add(st.step, st.load_factor, paths)
                 summary["wall_seconds"] = round(time.perf_counter() - t0, 4)
                 write_json(out / "summary.json", summary)
@@ -177,4 +178,11 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                                        {n: [r[3 + i] for r in rows] for i, n in enumerate(names)}, model.units)
             except ImportError:
                 pass
+        if spec.output.plots and ctl is not None and summary["debonded_area"]:
+            from .plots import plot_debonded_zone, plot_load_vs_area
+
+            plot_debonded_zone(out / "debonded_zone.png", ctl, f"λ = {summary['steps'][-1]['load_factor']:.3g}")
+            da = summary["debonded_area"]
+            plot_load_vs_area(out / "load_debonded_area.png", [a["load_factor"] for a in da],
+                              {k: [a[k] for a in da] for k in da[0] if k not in ("step", "load_factor")})
     return RunResult(summary["converged"], summary, problem, u, message)

@@ -60,6 +60,7 @@ class InterfaceController:
     settings: DelaminationSettings = field(default_factory=DelaminationSettings)
     resolves: int = 0  # re-solutions in the current step
     lam: float = 0.0
+    mesh_nodes: np.ndarray | None = None  # for plots
 
     # ------------------------------------------------------------------ set-up
     @classmethod
@@ -88,7 +89,7 @@ class InterfaceController:
             runs.append(InterfaceRun(blk, law, initial_laws.get(itf.upper, law), ini, z.copy(),
                                      np.zeros((ne, nq, 3)), np.zeros((ne, nq), bool), np.full((ne, nq), np.nan),
                                      z.copy(), np.zeros((ne, nq, 3)), z.copy()))
-        ctl = cls(runs, settings or DelaminationSettings())
+        ctl = cls(runs, settings or DelaminationSettings(), mesh_nodes=model.mesh.nodes)
         problem.extra_blocks = [r.block for r in runs]
         ctl.sync(problem)
         return ctl
