@@ -25,6 +25,7 @@ class Mesh:
     elements: np.ndarray  # (n_elements, 9) node indices
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
     element_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
 
     @property
     def n_nodes(self) -> int:
@@ -70,8 +71,9 @@ class Mesh:
             )
 
 
-def _structured(nx: int, ny: int, fn) -> Mesh:
-    """Structured (2nx+1) x (2ny+1) grid of quad9 elements; ``fn(s, t)`` maps [0,1]^2 to 3D."""
+def _structured(nx: int, ny: int, fn, edge_names=("s0", "s1", "t0", "t1")) -> Mesh:
+    """Structured (2nx+1) x (2ny+1) grid of quad9 elements; ``fn(s, t)`` maps [0,1]^2 to 3D.
+    The four boundary edges become node sets named ``edge_names`` (s = 0, s = 1, t = 0, t = 1)."""
     s = np.linspace(0.0, 1.0, 2 * nx + 1)
     t = np.linspace(0.0, 1.0, 2 * ny + 1)
     S, T = np.meshgrid(s, t, indexing="xy")
@@ -83,7 +85,8 @@ def _structured(nx: int, ny: int, fn) -> Mesh:
             i0, j0 = 2 * i, 2 * j
             loc = [(i0 + int(x + 1), j0 + int(y + 1)) for x, y in NODE_XI]
             elems.append([idx[jj, ii] for ii, jj in loc])
-    return Mesh(np.asarray(nodes, float), np.asarray(elems, dtype=np.int64))
+    sets = {edge_names[0]: idx[:, 0], edge_names[1]: idx[:, -1], edge_names[2]: idx[0, :], edge_names[3]: idx[-1, :]}
+    return Mesh(np.asarray(nodes, float), np.asarray(elems, dtype=np.int64), {k: np.array(v) for k, v in sets.items()})
 
 
 def _orient(mesh: Mesh, normal_fn) -> Mesh:
@@ -98,7 +101,8 @@ def rectangle(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0, 0.0), no
     """Flat rectangular plate in the x-y plane; ``normal`` '+z' (reference face at the bottom)
     or '-z' (reference face on top, material below)."""
     o = np.asarray(origin, float)
-    mesh = _structured(nx, ny, lambda s, t: np.stack([o[0] + lx * s, o[1] + ly * t, o[2] + 0 * s], -1))
+    mesh = _structured(nx, ny, lambda s, t: np.stack([o[0] + lx * s, o[1] + ly * t, o[2] + 0 * s], -1),
+                       ("xmin", "xmax", "ymin", "ymax"))
     sign = -1.0 if normal.strip().startswith("-") else 1.0
     return _orient(mesh, lambda c: np.tile([0.0, 0.0, sign], (len(c), 1)))
 
@@ -121,7 +125,7 @@ def cylinder(radius: float, angle_start: float, angle_end: float, width: float, 
             return np.stack([radius * np.cos(ph), radius * np.sin(ph), w], -1)
         return np.stack([radius * np.cos(ph), w, radius * np.sin(ph)], -1)
 
-    mesh = _structured(n_arc, n_width, fn)
+    mesh = _structured(n_arc, n_width, fn, ("start", "end", "bottom", "top"))
     sign = -1.0 if normal == "inward" else 1.0
 
     def want(c):
@@ -138,7 +142,8 @@ def revolution(meridian_r, meridian_z, n_meridian: int, n_circ: int, angle: floa
 
     The meridian is resampled by arc length to ``2 n_meridian + 1`` points. ``normal``
     'inward' or 'outward' relative to the axis (for a dome with the reference surface on the
-    inner face use 'outward').
+    inner face use 'outward'). Node sets: 'first'/'last' (the circles at the first and last
+    meridian point), 'start'/'end' (the meridians at angle 0 and ``angle``; merged when closed).
     """
     r = np.asarray(meridian_r, float)
     z = np.asarray(meridian_z, float)
@@ -153,7 +158,7 @@ def revolution(meridian_r, meridian_z, n_meridian: int, n_circ: int, angle: floa
         ph = np.deg2rad(angle) * s
         return np.stack([rr * np.cos(ph), rr * np.sin(ph), zz], -1)
 
-    mesh = _structured(n_circ, n_meridian, fn)
+    mesh = _structured(n_circ, n_meridian, fn, ("start", "end", "first", "last"))
     if closed:
         mesh = merge_coincident(mesh)
     sign = -1.0 if normal == "inward" else 1.0
@@ -183,4 +188,4 @@ def merge_coincident(mesh: Mesh, tol: float | None = None) -> Mesh:
     nodes = mesh.nodes[first[order]]
     elements = remap[inv.ravel()][mesh.elements]
     sets = {k: np.unique(remap[inv.ravel()][v]) for k, v in mesh.node_sets.items()}
-    return Mesh(nodes, elements, sets, dict(mesh.element_sets))
+    return Mesh(nodes, elements, sets, dict(mesh.element_sets), list(mesh.notes))

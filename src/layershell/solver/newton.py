@@ -2,8 +2,9 @@
 
 Each iteration solves K_r Δu_r = Tᵀ(λ F_a - f(u)) and updates u = u + T Δu_r. Convergence:
 relative residual ``‖r‖ ≤ tol_residual · ‖Tᵀ λF‖``; or, when the residual stalls at the
-round-off floor of an ill-conditioned (slender, multi-layer) system, a negligible correction
-``‖Δu‖ ≤ tol_displacement · ‖u‖`` together with ``‖r‖ ≤ tol_floor · ‖Tᵀ λF‖``.
+round-off floor of an ill-conditioned (slender, multi-layer) system, ``‖r‖ ≤ tol_floor · ‖Tᵀ λF‖``
+together with a negligible energy ``|Δu·r| ≤ tol_energy · |Δu₀·r₀|`` or a negligible correction
+``‖Δu‖ ≤ tol_displacement · ‖u‖``.
 """
 from __future__ import annotations
 
@@ -20,6 +21,7 @@ from .problem import Problem
 @dataclass
 class NewtonSettings:
     tol_residual: float = 1e-8
+    tol_energy: float = 1e-20
     tol_displacement: float = 1e-10
     tol_floor: float = 1e-5
     max_iterations: int = 25
@@ -92,6 +94,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     Fext = problem.external(lam)
     ref = np.linalg.norm(op.reduce(Fext))
     res = NewtonResult(False, 0)
+    e0 = None
     for it in range(s.max_iterations + 1):
         f, K = problem.assembler.evaluate(u, tangent=True)
         r = op.reduce(Fext - f)
@@ -113,8 +116,11 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
             return u, res
         dU = op.expand(du)
+        en = abs(float(du @ r))
+        e0 = en if e0 is None else e0
         if (it > 0 and rn <= s.tol_floor * scale
-                and np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300)):
+                and (en <= s.tol_energy * e0
+                     or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300))):
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             return u + dU, res
