@@ -18,3 +18,20 @@ def run_example(name: str, replace: dict[str, str] | None = None, out=None):
         text = text.replace(a, b)
     spec = build(parse(text, str(path)), path.parent)
     return run(spec, out, write_vtu=False)
+
+
+def fd_reduced_tangent(pb, ur, h=1e-6):
+    """Reduced tangent Tᵀ K T of ``pb`` at ``T ur`` and its central finite difference."""
+    import numpy as np
+
+    T = pb.op.T
+    _, K = pb.assembler.evaluate(T @ ur)
+    Kr = (T.T @ K @ T).toarray()
+    Kfd = np.zeros_like(Kr)
+    for j in range(ur.size):
+        e = np.zeros_like(ur)
+        e[j] = h
+        fp, _ = pb.assembler.evaluate(T @ (ur + e), tangent=False)
+        fm, _ = pb.assembler.evaluate(T @ (ur - e), tangent=False)
+        Kfd[:, j] = T.T @ (fp - fm) / (2 * h)
+    return Kr, Kfd

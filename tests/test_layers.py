@@ -1,7 +1,7 @@
 """Issue 3: layer stacks, the bond matrix, hinges, interlaminar results (MODEL.md §7-§8)."""
 import numpy as np
 import pytest
-from helpers import run_example
+from helpers import fd_reduced_tangent, run_example
 
 from layershell.constraints import constraint_operator
 from layershell.dofs import number_dofs
@@ -222,18 +222,7 @@ def test_tangent_after_bond_transformation(rng):
               Layer("c", Orthotropic.isotropic(300.0, 0.3), 2, th)]
     m = Model(mesh, layers, [(0, 1, 2)], np.zeros(1, int), fixes=[Fix(np.array([0, 3]), 0, (0,), (0, 1, 2))])
     pb = Problem.build(m)
-    T = pb.op.T
-    ur = 0.02 * rng.standard_normal(pb.op.n_red)
-    f, K = pb.assembler.evaluate(T @ ur)
-    Kr = (T.T @ K @ T).toarray()
-    h = 1e-6
-    Kfd = np.zeros_like(Kr)
-    for j in range(ur.size):
-        e = np.zeros_like(ur)
-        e[j] = h
-        fp, _ = pb.assembler.evaluate(T @ (ur + e), tangent=False)
-        fm, _ = pb.assembler.evaluate(T @ (ur - e), tangent=False)
-        Kfd[:, j] = T.T @ (fp - fm) / (2 * h)
+    Kr, Kfd = fd_reduced_tangent(pb, 0.02 * rng.standard_normal(pb.op.n_red))
     assert np.abs(Kr - Kfd).max() < 1e-6 * np.abs(Kr).max()
     assert np.allclose(Kr, Kr.T, atol=1e-10 * np.abs(Kr).max())
 

@@ -56,45 +56,37 @@ def test_membrane_patch_constant_stress(rng, d, nonlinear):
     assert np.allclose(ps.u[:, 1], -nu * sig * ps.X[:, 1] / E, rtol=1e-8, atol=1e-12)
 
 
+def _pure_bending_tip(d, nu, E=1e5, M=100.0):
+    """Beam of depth 1 under an end moment M per width (linear end traction), symmetry plane at
+    x = 0: deflection difference between the ends at mid-depth."""
+    m = rectangle(10.0, 1.0, 5, 1, normal="-z")
+    ly = Layer("b", Orthotropic.isotropic(E, nu), d, np.ones(m.n_nodes))
+    x = m.nodes
+    x0 = np.flatnonzero(np.isclose(x[:, 0], 0))
+    n0 = np.flatnonzero(np.isclose(x[:, 0], 0) & np.isclose(x[:, 1], 0))
+    model = Model(m, [ly], [(0,)], np.zeros(m.n_elements, int), fixes=[Fix(n0, 0, (0,), (1, 2))],
+                  symmetries=[Symmetry(x0, np.array([1.0, 0, 0]))],
+                  edge_loads=[EdgeLoad(_edges(m, np.isclose(x[:, 0], 10.0)), np.array([1.0, 0, 0]),
+                                       lambda theta3, **kw: 12 * M * (theta3 - 0.5))], nonlinear=False)
+    pb = Problem.build(model)
+    st = list(load_steps(pb, np.array([1.0])))[-1]
+    ps = evaluate_points(model, pb.dm, st.u, [4, 0], [-1.0, 1.0], [0.0, 0.0], [0.5, 0.5])  # x = 10, x = 0 (flipped)
+    return ps.u[0, 2] - ps.u[1, 2]
+
+
 @pytest.mark.parametrize("d", [2, 3, 4])
 def test_pure_bending_is_exact(d):
     """A linear through-thickness end traction (pure bending moment M per width) on a beam of
     depth 1 with a symmetry plane at x = 0 and ν = 0.4: the 3D solution is quadratic, so the
     deflection M l²/(2EI) is reproduced to round-off for d ≥ 2."""
-    m = rectangle(10.0, 1.0, 5, 1, normal="-z")
-    E, M = 1e5, 100.0
-    ly = Layer("b", Orthotropic.isotropic(E, 0.4), d, np.ones(m.n_nodes))
-    x = m.nodes
-    x0 = np.flatnonzero(np.isclose(x[:, 0], 0))
-    n0 = np.flatnonzero(np.isclose(x[:, 0], 0) & np.isclose(x[:, 1], 0))
-    model = Model(m, [ly], [(0,)], np.zeros(m.n_elements, int), fixes=[Fix(n0, 0, (0,), (1, 2))],
-                  symmetries=[Symmetry(x0, np.array([1.0, 0, 0]))],
-                  edge_loads=[EdgeLoad(_edges(m, np.isclose(x[:, 0], 10.0)), np.array([1.0, 0, 0]),
-                                       lambda theta3, **kw: 12 * M * (theta3 - 0.5))], nonlinear=False)
-    pb = Problem.build(model)
-    st = list(load_steps(pb, np.array([1.0])))[-1]
-    ps = evaluate_points(model, pb.dm, st.u, [4, 0], [-1.0, 1.0], [0.0, 0.0], [0.5, 0.5])  # x = 10, x = 0 (flipped elements)
-    w = ps.u[0, 2] - ps.u[1, 2]
-    assert np.isclose(w, M * 100 / (2 * E / 12), rtol=1e-9)
+    assert np.isclose(_pure_bending_tip(d, 0.4), 100.0 * 100 / (2 * 1e5 / 12), rtol=1e-9)
 
 
 def test_d1_shows_poisson_thickness_locking():
     """With d = 1 the thickness strain is constant through the thickness, so pure bending is
     too stiff by the factor 1 - ν² (the reason the thesis recommends d ≥ 2)."""
-    m = rectangle(10.0, 1.0, 5, 1, normal="-z")
-    nu, E, M = 0.4, 1e5, 100.0
-    ly = Layer("b", Orthotropic.isotropic(E, nu), 1, np.ones(m.n_nodes))
-    x = m.nodes
-    x0 = np.flatnonzero(np.isclose(x[:, 0], 0))
-    n0 = np.flatnonzero(np.isclose(x[:, 0], 0) & np.isclose(x[:, 1], 0))
-    model = Model(m, [ly], [(0,)], np.zeros(m.n_elements, int), fixes=[Fix(n0, 0, (0,), (1, 2))],
-                  symmetries=[Symmetry(x0, np.array([1.0, 0, 0]))],
-                  edge_loads=[EdgeLoad(_edges(m, np.isclose(x[:, 0], 10.0)), np.array([1.0, 0, 0]),
-                                       lambda theta3, **kw: 12 * M * (theta3 - 0.5))], nonlinear=False)
-    pb = Problem.build(model)
-    st = list(load_steps(pb, np.array([1.0])))[-1]
-    ps = evaluate_points(model, pb.dm, st.u, [4, 0], [-1.0, 1.0], [0.0, 0.0], [0.5, 0.5])  # x = 10, x = 0 (flipped elements)
-    assert np.isclose(ps.u[0, 2] - ps.u[1, 2], M * 100 / (2 * E / 12) * (1 - nu**2), rtol=1e-6)
+    nu = 0.4
+    assert np.isclose(_pure_bending_tip(1, nu), 100.0 * 100 / (2 * 1e5 / 12) * (1 - nu**2), rtol=1e-6)
 
 
 def test_homogeneous_large_stretch_stress_measures(rng):

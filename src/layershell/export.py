@@ -16,13 +16,13 @@ Points are undeformed positions; ParaView's *Warp By Vector* uses the ``displace
 from __future__ import annotations
 
 import os
-import uuid
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
 
 from .dofs import DofMap
+from .io.output import atomic_write
 from .element.shape import NODE_XI
 from .model import Model
 
@@ -106,26 +106,10 @@ def von_mises(t: np.ndarray) -> np.ndarray:
     )
 
 
-def _atomic_write(path: Path, write) -> None:
-    """Call ``write(tmp_path)`` on a temporary file next to ``path`` and rename it into place."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".{path.name}.{os.getpid()}.{uuid.uuid4().hex[:8]}.tmp"
-    try:
-        write(Path(tmp))
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
-
-
 def _write_vtu(path: Path, mesh) -> None:
     import meshio
 
-    _atomic_write(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
+    atomic_write(path, lambda tmp: meshio.write(str(tmp), mesh, file_format="vtu"))
 
 
 # ----------------------------------------------------------------------------- meshes
@@ -282,7 +266,7 @@ def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
         ET.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0", file=str(f))
     ET.indent(root)
     text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-    _atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
 
 
 class PvdWriter:
