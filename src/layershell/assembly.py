@@ -78,21 +78,25 @@ class Assembler:
 
     def evaluate(self, u_full: np.ndarray, tangent: bool = True):
         """Return ``(f_int, K)`` (K None when ``tangent`` is False)."""
-        f = np.zeros(self.dm.n_full)
+        n = self.dm.n_full
+        fidx, fval = [], []
         vals = [] if tangent else None
         for b in self.blocks:
             U = u_full[b.dofs].reshape(b.dofs.shape[0], -1, 3)
             for s in range(0, b.dofs.shape[0], self.chunk):
                 sl = slice(s, s + self.chunk)
                 fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, tangent, sl)
-                np.add.at(f, b.dofs[sl].ravel(), fe.ravel())
+                fidx.append(b.dofs[sl].ravel())
+                fval.append(fe.ravel())
                 if tangent:
                     vals.append(Ke.ravel())
         for b in self.extra:
             fe, Ke = b.response(u_full)
-            np.add.at(f, b.dofs.ravel(), fe.ravel())
+            fidx.append(b.dofs.ravel())
+            fval.append(fe.ravel())
             if tangent:
                 vals.append(Ke.ravel())
+        f = np.bincount(np.concatenate(fidx), weights=np.concatenate(fval), minlength=n)
         if not tangent:
             return f, None
         data = np.bincount(self.scatter, weights=np.concatenate(vals), minlength=self.nnz)

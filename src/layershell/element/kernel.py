@@ -139,15 +139,15 @@ def voigt_to_matrix(S: np.ndarray) -> np.ndarray:
 
 
 def strain_displacement(F: np.ndarray, g: np.ndarray) -> np.ndarray:
-    """B_(a i),V = ∂E_V/∂U_ai (Voigt, engineering shear), shape ``(e, q, a, 3, 6)``."""
-    Fg = np.einsum("eqiJ,eqaK->eqaiJK", F, g)
+    """B_(a i),V = ∂E_V/∂U_ai (Voigt, engineering shear) in the layout ``(e, a, i, q, 6)``
+    (element DOF major, then point and Voigt index), built from nine (e, a, i, q) products
+    F_iJ g_aK so that the element stiffness is one contiguous batched GEMM."""
+    P = {}
+    for J in range(3):
+        for K in range(3):
+            P[J, K] = np.einsum("eqi,eqa->eaiq", F[..., :, J], g[..., :, K])
     return np.stack(
-        [
-            Fg[..., 0, 0], Fg[..., 1, 1], Fg[..., 2, 2],
-            Fg[..., 1, 2] + Fg[..., 2, 1], Fg[..., 0, 2] + Fg[..., 2, 0], Fg[..., 0, 1] + Fg[..., 1, 0],
-        ],
-        axis=-1,
-    )
+        [P[0, 0], P[1, 1], P[2, 2], P[1, 2] + P[2, 1], P[0, 2] + P[2, 0], P[0, 1] + P[1, 0]], axis=-1)
 
 
 def layer_response(
@@ -167,15 +167,17 @@ def layer_response(
     F = _I3 + Hgrad if nonlinear else np.broadcast_to(_I3, Hgrad.shape)
     Ev = green_lagrange(Hgrad, nonlinear)
     S = np.einsum("eqvw,eqw->eqv", C, Ev)
-    B = strain_displacement(F, g)
+    B = strain_displacement(F, g)  # (e, a, i, q, 6)
     e, q, a = g.shape[:3]
     m = a * 3
-    f = np.einsum("eqaiv,eqv->eai", B, S * dV[..., None]).reshape(e, m)
+    Bm = B.reshape(e, m, q, 6)
+    f = np.einsum("emqv,eqv->em", Bm, S * dV[..., None])
     if not tangent:
         return f, None
-    Bm = B.reshape(e, q, m, 6)
-    CB = np.einsum("eqvw,eqmw->eqvm", C * dV[..., None, None], Bm)  # (e, q, 6, m)
-    K = np.matmul(np.transpose(Bm, (0, 2, 1, 3)).reshape(e, m, q * 6), CB.reshape(e, q * 6, m))
+    # K = (B C) Bᵀ: both operands in (e, m, q·6) layout, the second as a transposed view (BLAS)
+    BC = np.matmul(Bm.transpose(0, 2, 1, 3), C * dV[..., None, None])  # (e, q, m, 6)
+    BC = BC.transpose(0, 2, 1, 3).reshape(e, m, q * 6)
+    K = np.matmul(BC, Bm.reshape(e, m, q * 6).transpose(0, 2, 1))
     if nonlinear:
         Kg = np.einsum("eqaJ,eqJK,eqbK->eab", g, voigt_to_matrix(S) * dV[..., None, None], g, optimize=True)
         K = K.reshape(e, a, 3, a, 3)
