@@ -102,12 +102,14 @@ def main() -> None:
     consts = homogenise()
     print()
     for name, (ec, H) in consts.items():
-        print(f"[materials.cfrp_{name}]   # element layer {name}, H = {H:.2f} mm")
+        a, b = REGIONS[name]
+        angles = "/".join(f"{x:g}" for x in ANGLES[a - 1: b])
+        print(f"[materials.cfrp_{name}]   # element layer {name}, plies {a}-{b} ({angles}), H = {H:.2f} mm")
         print('type = "orthotropic"')
         for k in ("E1", "E2", "E3", "G12", "G23", "G31"):
             print(f"{k} = {ec[k]:.1f}")
         for k in ("nu12", "nu23", "nu31"):
-            print(f"{k} = {ec[k]:.5f}")
+            print(f"{k} = {ec[k]:.6g}")
         print()
     t = edge_tractions(consts)
     H = {k: consts[k][1] for k in consts}
