@@ -26,3 +26,18 @@ test-all: $(STAMP)
 
 clean:
 	rm -rf $(VENV) results build src/*.egg-info
+
+# Distributed runs (MPI + PETSc, docs/distributed.md); not part of `make test`. Needs the system
+# packages: `apt-get install python3-petsc4py python3-mpi4py` (petsc4py has no PyPI wheels).
+VENV_MPI  := .venv-mpi
+PETSC_DIR ?= /usr/lib/petscdir/petsc3.18/x86_64-linux-gnu-real
+
+$(VENV_MPI)/.installed: pyproject.toml
+	/usr/bin/python3 -m venv --system-site-packages $(VENV_MPI)
+	/usr/bin/python3 -c "import numpy; print('numpy==' + numpy.__version__)" > $(VENV_MPI)/constraints.txt
+	PETSC_DIR=$(PETSC_DIR) $(VENV_MPI)/bin/python -m pip install -q -c $(VENV_MPI)/constraints.txt -e ".[test]"
+	touch $@
+
+.PHONY: test-mpi
+test-mpi: $(STAMP) $(VENV_MPI)/.installed
+	PETSC_DIR=$(PETSC_DIR) LAYERSHELL_MPI_PYTHON=$(VENV_MPI)/bin/python $(BIN)/python -m pytest -rs tests/test_petsc.py

@@ -1,8 +1,11 @@
-"""Global assembly in the full DOF space with a precomputed scatter map.
+"""Global assembly with precomputed scatter maps, in the full and in the reduced DOF space.
 
-The sparsity pattern is built once; each Newton iteration only sums element values into the
-CSR data array (``np.bincount`` over a cached index). Reduction to independent DOFs,
-K_r = Tᵀ K T, follows (3.69)-(3.72).
+The full-space sparsity pattern is built once; each Newton iteration only sums element values
+into the CSR data array (``np.bincount`` over a cached index). The reduced tangent
+K_r = Tᵀ K T (3.69)-(3.72) is formed without sparse matrix products: once per constraint
+operator (bond state) a :class:`ReducedScatter` fixes the pattern of K_r and a sparse map P with
+``K_r.data = P @ K.data``, so every iteration costs one ``bincount`` and one sparse
+matrix-vector product, and K_r keeps the same pattern (PARDISO reuses its symbolic analysis).
 """
 from __future__ import annotations
 
@@ -43,8 +46,170 @@ def build_blocks(model: Model, dm: DofMap) -> list[Block]:
     return blocks
 
 
+def _index_dtype(n: int):
+    """int32 where it can hold ``n`` (halves the memory of index arrays), int64 otherwise."""
+    return np.int32 if n < np.iinfo(np.int32).max else np.int64
+
+
+class ReducedScatter:
+    """Pattern of K_r = Tᵀ K T and the map ``P (nnz_r × nnz)`` with ``K_r.data = P @ K.data``.
+
+    Entry p = (i, j) of K contributes ``T[i, a] T[j, b] K_p`` to entry (a, b) of K_r
+    (3.69)-(3.72). P is stored column-wise (CSC: one column per entry of K), which is the
+    order in which the contributions are generated, so it is built without sorting.
+    The pattern is structural (no value-dependent cancellation), hence fixed for a bond state.
+    Compiled loops (``_assembly_jit``) when Numba is available, vectorised NumPy otherwise
+    (``jit=False`` forces the NumPy path).
+    """
+
+    def __init__(self, T: sp.csr_matrix, indptr: np.ndarray, indices: np.ndarray, chunk: int = 1 << 22,
+                 jit: bool | None = None):
+        T = sp.csr_matrix(T)
+        T.sum_duplicates()
+        T.sort_indices()
+        n_full, n_red = T.shape
+        self.shape = (n_red, n_red)
+        nnz = int(indptr[-1])
+        nT = np.diff(T.indptr).astype(np.int64)
+        rows = np.repeat(np.arange(n_full, dtype=_index_dtype(n_full)), np.diff(indptr))
+        cnt = nT[rows] * nT[indices]
+        col_ptr = np.zeros(nnz + 1, np.int64)
+        np.cumsum(cnt, out=col_ptr[1:])
+        del cnt
+        total = int(col_ptr[-1])
+        jit_mod = None
+        if jit is not False:
+            try:
+                from . import _assembly_jit as jit_mod
+            except ImportError:  # pragma: no cover - Numba missing
+                if jit:
+                    raise
+        if jit_mod is not None:
+            Tt = T.T.tocsr()
+            Tt.sort_indices()
+            bp, bi = jit_mod.reduced_pattern(n_red, Tt.indptr, Tt.indices, indptr, indices, T.indptr, T.indices)
+            del Tt
+            self.nnz = int(bp[-1])
+            it = _index_dtype(max(self.nnz, n_red))
+            self.indptr, self.indices = bp.astype(it), bi.astype(it)
+            q_all = np.empty(total, _index_dtype(max(self.nnz, nnz)))
+            w_all = np.empty(total)
+            jit_mod.reduced_map(n_red, indptr, indices, T.indptr, T.indices, T.data, self.indptr, self.indices,
+                                col_ptr, q_all, w_all)
+        else:
+            q_all, w_all = self._map_numpy(T, indptr, indices, rows, nT, col_ptr, chunk)
+            it = _index_dtype(max(self.nnz, n_red))
+        del rows
+        self.P = sp.csc_matrix((w_all, q_all, col_ptr.astype(_index_dtype(total))), shape=(self.nnz, nnz))
+        del w_all, q_all, col_ptr
+        # --- upper triangle (PARDISO's symmetric mode) and the mirror of each upper entry
+        red_rows = np.repeat(np.arange(n_red, dtype=it), np.diff(self.indptr))
+        up = self.indices >= red_rows
+        self.upper_pos = np.flatnonzero(up).astype(it)
+        self.upper_indices = self.indices[up]
+        self.upper_indptr = np.zeros(n_red + 1, it)
+        np.cumsum(np.bincount(red_rows[up], minlength=n_red), out=self.upper_indptr[1:])
+        up_rows = red_rows[up]
+        del red_rows, up
+        if self.nnz == 0:
+            mirror = np.zeros(0, np.int64)
+        elif jit_mod is not None:
+            mirror = jit_mod.mirror_positions(self.indptr, self.indices, self.upper_pos, up_rows)
+        else:
+            keys = np.repeat(np.arange(n_red, dtype=np.int64), np.diff(self.indptr)) * n_red + self.indices
+            tk = self.upper_indices.astype(np.int64) * n_red + up_rows
+            mirror = np.minimum(np.searchsorted(keys, tk), max(self.nnz - 1, 0))
+            mirror[keys[mirror] != tk] = -1
+            del keys, tk
+        self.mirror_pos = mirror.astype(it) if self.nnz == 0 or mirror.min() >= 0 else None
+        if int(np.count_nonzero(self.upper_indices == up_rows)) != n_red:
+            self.upper_indices = None  # a diagonal entry is missing: PARDISO needs them, general path
+
+    def _map_numpy(self, T, indptr, indices, rows, nT, col_ptr, chunk):
+        """Vectorised pattern and map (fallback without Numba): the pattern as the symbolic product
+        |T|ᵀ S |T| (positive entries: nothing cancels), positions by binary search."""
+        n_full, n_red = T.shape
+        nnz = int(indptr[-1])
+        S = sp.csr_matrix((np.ones(nnz), indices, indptr), shape=(n_full, n_full))
+        Ta = abs(T)
+        B = (Ta.T.tocsr() @ S @ Ta).tocsr()
+        del S, Ta
+        B.sort_indices()
+        self.nnz = B.nnz
+        it = _index_dtype(max(self.nnz, n_red))
+        self.indptr = B.indptr.astype(it)
+        self.indices = B.indices.astype(it)
+        keys = np.repeat(np.arange(n_red, dtype=np.int64), np.diff(B.indptr)) * n_red + B.indices
+        del B
+        tp, ti, tv = T.indptr.astype(np.int64), T.indices.astype(np.int64), T.data
+        total = int(col_ptr[-1])
+        q_all = np.empty(total, _index_dtype(max(self.nnz, nnz)))
+        w_all = np.empty(total)
+        cnt = np.diff(col_ptr)
+        # chunks of K entries with about `chunk` contributions each (bounded temporaries)
+        bounds = np.searchsorted(col_ptr, np.arange(0, total + chunk, chunk), side="left")
+        bounds = np.unique(np.concatenate([[0], np.clip(bounds, 0, nnz), [nnz]]))
+        for p0, p1 in zip(bounds[:-1], bounds[1:]):
+            i, j, c = rows[p0:p1].astype(np.int64), indices[p0:p1].astype(np.int64), cnt[p0:p1]
+            s0, s1 = col_ptr[p0], col_ptr[p1]
+            k = np.arange(s1 - s0) - np.repeat(col_ptr[p0:p1] - s0, c)  # index within (i, j)'s block
+            nj = np.repeat(nT[j], c)
+            ta = np.repeat(tp[i], c) + k // nj
+            tb = np.repeat(tp[j], c) + k % nj
+            q_all[s0:s1] = np.searchsorted(keys, ti[ta] * n_red + ti[tb])
+            w_all[s0:s1] = tv[ta] * tv[tb]
+        return q_all, w_all
+
+    def matrix(self, data_full: np.ndarray) -> "ReducedTangent":
+        """K_r for the values ``data_full`` of the full-space pattern."""
+        K = ReducedTangent((self.P @ data_full, self.indices, self.indptr), shape=self.shape)
+        K.indices, K.indptr = self.indices, self.indptr  # share (SciPy may copy them): no copy per iteration
+        K.has_sorted_indices = True
+        K.scatter = self
+        return K
+
+    def memory_bytes(self) -> int:
+        arrays = [self.P.data, self.P.indices, self.P.indptr, self.indices, self.indptr, self.upper_pos,
+                  self.mirror_pos, self.upper_indices, self.upper_indptr]
+        return sum(a.nbytes for a in arrays if a is not None)
+
+
+class ReducedTangent(sp.csr_matrix):
+    """K_r in CSR that knows the index maps of its pattern (:class:`ReducedScatter`), so that the
+    symmetry check and the upper triangle for PARDISO (solver/linear.py) are O(nnz) gathers
+    instead of sparse transposes and sorts. Matrices derived from it by SciPy operations lose
+    the maps and take the general path."""
+
+    scatter: ReducedScatter | None = None
+
+    def _maps(self) -> ReducedScatter | None:
+        rs = self.scatter
+        if rs is not None and self.indices is rs.indices and self.indptr is rs.indptr:
+            return rs
+        return None
+
+    def symmetry_error(self) -> float | None:
+        """max |K_ab - K_ba| (None where the maps do not apply)."""
+        rs = self._maps()
+        if rs is None or rs.mirror_pos is None:
+            return None
+        if self.nnz == 0:
+            return 0.0
+        return float(np.max(np.abs(self.data[rs.upper_pos] - self.data[rs.mirror_pos])))
+
+    def upper_triangle(self) -> sp.csr_matrix | None:
+        """The upper triangle with every diagonal entry stored, sorted CSR (None where the maps
+        do not apply)."""
+        rs = self._maps()
+        if rs is None or rs.upper_indices is None:
+            return None
+        A = sp.csr_matrix((self.data[rs.upper_pos], rs.upper_indices, rs.upper_indptr), shape=self.shape)
+        A.has_sorted_indices = True
+        return A
+
+
 class Assembler:
-    """Internal forces and tangent of the whole model in the full DOF space."""
+    """Internal forces and tangent of the whole model, in the full or the reduced DOF space."""
 
     def __init__(self, model: Model, dm: DofMap, chunk: int = 256):
         self.model, self.dm, self.chunk = model, dm, chunk
@@ -59,46 +224,97 @@ class Assembler:
         self._pattern()
 
     def _pattern(self) -> None:
+        """Full-space CSR pattern and the scatter index of every element entry into it
+        (compiled row-by-row construction without sorting the entries when Numba is available)."""
         n = self.dm.n_full
-        rows, cols = [], []
-        for b in [*self.blocks, *self.extra]:
-            m = b.dofs.shape[1]
-            rows.append(np.repeat(b.dofs, m, axis=1).ravel())
-            cols.append(np.tile(b.dofs, (1, m)).ravel())
-        r = np.concatenate(rows).astype(np.int64)
-        c = np.concatenate(cols).astype(np.int64)
-        key = r * n + c
-        ukey, self.scatter = np.unique(key, return_inverse=True)
-        ur, uc = ukey // n, ukey % n
-        indptr = np.zeros(n + 1, np.int64)
-        np.add.at(indptr, ur + 1, 1)
-        self.indptr = np.cumsum(indptr)
-        self.indices = uc
-        self.nnz = ukey.size
+        blocks = [*self.blocks, *self.extra]
+        self.n_entries = int(sum(b.dofs.shape[0] * b.dofs.shape[1] ** 2 for b in blocks))
+        try:
+            from . import _assembly_jit as jit_mod
+        except ImportError:  # pragma: no cover - Numba missing
+            jit_mod = None
+        if jit_mod is not None and blocks:
+            dofs = np.concatenate([b.dofs.ravel() for b in blocks]).astype(np.int64)
+            m = np.concatenate([np.full(b.dofs.shape[0], b.dofs.shape[1], np.int64) for b in blocks])
+            estart = np.concatenate([[0], np.cumsum(m)])
+            vstart = np.concatenate([[0], np.cumsum(m * m)])
+            # the CSR pattern has fewer entries than the element matrices together
+            self.scatter = np.empty(self.n_entries, _index_dtype(max(self.n_entries, n)))
+            indptr, indices = jit_mod.full_pattern(n, dofs, estart, vstart, self.scatter)
+            self.nnz = int(indptr[-1])
+            it = _index_dtype(max(self.nnz, n))
+            self.indptr, self.indices = indptr.astype(it), indices.astype(it)
+            if self.scatter.dtype != it:
+                self.scatter = self.scatter.astype(it)
+        else:
+            self._pattern_numpy(blocks)
+        self._reduced: tuple[object, ReducedScatter] | None = None
 
-    def evaluate(self, u_full: np.ndarray, tangent: bool = True):
-        """Return ``(f_int, K)`` (K None when ``tangent`` is False)."""
+    def _pattern_numpy(self, blocks: list) -> None:
+        """The same by sorting all element entries (fallback without Numba)."""
         n = self.dm.n_full
-        fidx, fval = [], []
-        vals = [] if tangent else None
+        keys = []
+        for b in blocks:
+            d = b.dofs.astype(np.int64)
+            keys.append((d[:, :, None] * n + d[:, None, :]).ravel())
+        key = np.concatenate(keys) if keys else np.zeros(0, np.int64)
+        del keys
+        ukey, scatter = np.unique(key, return_inverse=True)
+        del key
+        self.nnz = ukey.size
+        it = _index_dtype(max(self.nnz, n))
+        self.scatter = scatter.astype(it)
+        del scatter
+        ur = ukey // n
+        self.indices = (ukey % n).astype(it)
+        del ukey
+        self.indptr = np.zeros(n + 1, it)
+        np.cumsum(np.bincount(ur, minlength=n), out=self.indptr[1:])
+
+    def reduced_scatter(self, op) -> ReducedScatter:
+        """The reduced pattern and map for constraint operator ``op`` (cached per operator)."""
+        if self._reduced is None or self._reduced[0] is not op:
+            self._reduced = None  # free the previous map first
+            self._reduced = (op, ReducedScatter(op.T, self.indptr, self.indices))
+        return self._reduced[1]
+
+    def _values(self, u_full: np.ndarray, tangent: bool):
+        """Full-space internal force and (when ``tangent``) the summed CSR data of K."""
+        n = self.dm.n_full
+        f = np.zeros(n)
+        vals = np.empty(self.n_entries) if tangent else None
+        pos = 0
         for b in self.blocks:
             U = u_full[b.dofs].reshape(b.dofs.shape[0], -1, 3)
             for s in range(0, b.dofs.shape[0], self.chunk):
                 sl = slice(s, s + self.chunk)
                 fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, tangent, sl)
-                fidx.append(b.dofs[sl].ravel())
-                fval.append(fe.ravel())
+                f += np.bincount(b.dofs[sl].ravel(), weights=fe.ravel(), minlength=n)
                 if tangent:
-                    vals.append(Ke.ravel())
+                    vals[pos:pos + Ke.size] = Ke.ravel()
+                    pos += Ke.size
         for b in self.extra:
             fe, Ke = b.response(u_full)
-            fidx.append(b.dofs.ravel())
-            fval.append(fe.ravel())
+            f += np.bincount(b.dofs.ravel(), weights=fe.ravel(), minlength=n)
             if tangent:
-                vals.append(Ke.ravel())
-        f = np.bincount(np.concatenate(fidx), weights=np.concatenate(fval), minlength=n)
+                vals[pos:pos + Ke.size] = np.ravel(Ke)
+                pos += Ke.size
         if not tangent:
             return f, None
-        data = np.bincount(self.scatter, weights=np.concatenate(vals), minlength=self.nnz)
+        return f, np.bincount(self.scatter, weights=vals, minlength=self.nnz)
+
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True):
+        """Return ``(f_int, K)`` in the full space (K None when ``tangent`` is False)."""
+        f, data = self._values(u_full, tangent)
+        if data is None:
+            return f, None
         K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.dm.n_full,) * 2)
+        K.has_sorted_indices = True
         return f, K
+
+    def evaluate_reduced(self, u_full: np.ndarray, op):
+        """Return ``(f_int, K_r)``: the full-space internal force and the reduced tangent
+        K_r = Tᵀ K T of constraint operator ``op`` (3.69)-(3.72), by the cached reduced scatter."""
+        rs = self.reduced_scatter(op)
+        f, data = self._values(u_full, True)
+        return f, rs.matrix(data)

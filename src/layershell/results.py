@@ -134,25 +134,25 @@ def evaluate_points(
 def locate(model: Model, point, tol: float | None = None) -> tuple[int, float, float, float]:
     """Element and (ξ, η) of the reference-surface point nearest to ``point``, and the distance.
 
-    Projects by Newton iterations on every element near the point and keeps the closest."""
+    Projects by Gauss-Newton iterations (clipped to the element) on the 12 elements with the
+    nearest centres at once (vectorised) and keeps the closest."""
     point = np.asarray(point, float)
     mesh = model.mesh
     centres = mesh.nodes[mesh.elements].mean(1)
-    order = np.argsort(np.linalg.norm(centres - point, axis=1))[:12]
-    best = (1e300, 0, 0.0, 0.0)
-    for e in order:
-        X = mesh.nodes[mesh.elements[e]][None]
-        x = np.zeros(2)
-        for _ in range(30):
-            sp = surface_points(X, x[:1], x[1:])
-            r = sp.X0[0, 0] - point
-            A = sp.A[0, 0]
-            step = np.linalg.lstsq(A, -r, rcond=None)[0]
-            x = np.clip(x + step, -1.0, 1.0)
-            if np.linalg.norm(step) < 1e-13:
-                break
-        sp = surface_points(X, x[:1], x[1:])
-        dist = float(np.linalg.norm(sp.X0[0, 0] - point))
-        if dist < best[0] - 1e-12:
-            best = (dist, int(e), float(x[0]), float(x[1]))
-    return best[1], best[2], best[3], best[0]
+    order = np.argsort(np.linalg.norm(centres - point, axis=1), kind="stable")[:12]
+    X = mesh.nodes[mesh.elements[order]]  # (c, 9, 3)
+    x = np.zeros((order.size, 2))
+    for _ in range(30):
+        sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+        r = sp.X0[:, 0] - point  # (c, 3)
+        A = sp.A[:, 0]  # (c, 3, 2)
+        G = np.einsum("cia,cib->cab", A, A)
+        step = -np.linalg.solve(G, np.einsum("cia,ci->ca", A, r)[..., None])[..., 0]
+        x = np.clip(x + step, -1.0, 1.0)
+        if np.abs(step).max() < 1e-13:
+            break
+    sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+    dist = np.linalg.norm(sp.X0[:, 0] - point, axis=1)
+    # the first of the (nearly) closest, in order of the element centres' distance
+    k = int(np.flatnonzero(dist <= dist.min() + 1e-12)[0])
+    return int(order[k]), float(x[k, 0]), float(x[k, 1]), float(dist[k])

@@ -12,9 +12,18 @@ shell is a 3D continuum with the tensor-product basis ``phi_(n,l) = N_n(Θ¹,Θ�
 Axes: ``e`` element, ``q`` integration point, ``a`` basis function (node-major, then
 director), ``i`` Cartesian DOF direction, ``V`` Voigt index [11, 22, 33, 23, 13, 12].
 Element DOF order = (node, director, direction), i.e. direction fastest (2.271).
+
+:func:`layer_response` evaluates this in factored form (C dV = L Lᵀ, K_mat = (B L)(B L)ᵀ as one
+BLAS syrk per element; point loops compiled with Numba in ``_jit.py``; elements split over
+``LAYERSHELL_THREADS`` threads). :func:`layer_response_reference` is the literal NumPy form,
+kept as the independent check (tests/test_kernel_fast.py) and for benchmarks/kernel.py.
 """
 from __future__ import annotations
 
+import os
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import nullcontext
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,12 +41,15 @@ class LayerBlock:
 
     gradphi (e, q, a, 3): material gradients of the basis functions
     dV (e, q): volume weights μ √A κ H_L/2 (3.47); C (e, q, 6, 6): Cartesian stiffness
+    L (e, q, 6, 6): lower Cholesky factor of C·dV (C dV = L Lᵀ), or None where C·dV is not
+    positive definite at some point (the kernel then uses the general product B (C dV) Bᵀ)
     """
 
     d: int
     gradphi: np.ndarray
     dV: np.ndarray
     C: np.ndarray
+    L: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
@@ -112,8 +124,22 @@ def layer_block(
     frame = material_frame(sp, angle_deg, direction)  # (e, q, 3, 3)
     C = rotate_stiffness(material.stiffness(), frame)  # (e, q, 6, 6)
     e, q, z = dV.shape
-    C = np.broadcast_to(C[:, :, None], (e, q, z, 6, 6)).reshape(e, q * z, 6, 6)
-    return LayerBlock(d, g.reshape(e, q * z, -1, 3), dV.reshape(e, q * z), np.ascontiguousarray(C))
+    C = np.ascontiguousarray(np.broadcast_to(C[:, :, None], (e, q, z, 6, 6)).reshape(e, q * z, 6, 6))
+    dV = dV.reshape(e, q * z)
+    return LayerBlock(d, np.ascontiguousarray(g.reshape(e, q * z, -1, 3)), dV, C, stiffness_factor(C, dV))
+
+
+def stiffness_factor(C: np.ndarray, dV: np.ndarray) -> np.ndarray | None:
+    """Lower Cholesky factor L of C·dV per point (``(e, q, 6, 6)``), None if not positive definite.
+
+    With it the material tangent Bᵀ (C dV) B = (B L)(B L)ᵀ is a symmetric rank-k product (2.268).
+    """
+    if not np.all(dV > 0):
+        return None
+    try:
+        return np.linalg.cholesky(C * dV[..., None, None])
+    except np.linalg.LinAlgError:
+        return None
 
 
 def green_lagrange(Hgrad: np.ndarray, nonlinear: bool = True) -> np.ndarray:
@@ -150,17 +176,16 @@ def strain_displacement(F: np.ndarray, g: np.ndarray) -> np.ndarray:
         [P[0, 0], P[1, 1], P[2, 2], P[1, 2] + P[2, 1], P[0, 2] + P[2, 0], P[0, 1] + P[1, 0]], axis=-1)
 
 
-def layer_response(
+def layer_response_reference(
     block: LayerBlock,
     U: np.ndarray,
     nonlinear: bool = True,
     tangent: bool = True,
     sl: slice = slice(None),
 ):
-    """Internal force ``(e, a*3)`` and tangent ``(e, a*3, a*3)`` of a layer block.
+    """Plain NumPy form of :func:`layer_response` (Voigt B and C, (2.267)-(2.268) literally).
 
-    ``U (e, a, 3)`` are the element's nodal director vectors; ``sl`` restricts to an
-    element range (for chunked assembly).
+    Kept as the independent second computation the fast kernel is tested against.
     """
     g, dV, C = block.gradphi[sl], block.dV[sl], block.C[sl]
     Hgrad = np.einsum("eai,eqaJ->eqiJ", U, g)
@@ -184,3 +209,125 @@ def layer_response(
         K += Kg[:, :, None, :, None] * _I3[None, None, :, None, :]
         K = K.reshape(e, m, m)
     return f, K
+
+
+# --------------------------------------------------------------------------------------------
+# Fast kernel. Per point (2.267)-(2.268) with B_(ai)V = Σ_JK Q_V,JK F_iJ g_aK (Q: Voigt map):
+#   f_ai  = Σ_q Σ_K g_aK (S dV F ᵀ)_Ki
+#   K_mat = Σ_q (B L)(B L)ᵀ with C dV = L Lᵀ: stacking the points, X_e = [B_q L_q]_q is a
+#           (6q × m) matrix and K_mat = X_eᵀ X_e is one symmetric rank-k BLAS product (syrk,
+#           half the flops of the general product), (B L)_(ai)W = Σ_K g_aK Φ_WKi with
+#           Φ_WKi = Σ_J F_iJ L_Q(J,K),W
+#   K_geo = δ_ik Σ_q g_aJ (S dV)_JK g_bK: one GEMM (a × 3q)(3q × a) per element.
+# The point work is compiled (Numba, no GIL); elements are split over threads with BLAS
+# itself single-threaded (small products parallelise better over elements than inside BLAS).
+# --------------------------------------------------------------------------------------------
+
+_SUB = 8  # elements per sub-block: its X (8 × 140 kB for d = 3) stays in cache for the product
+
+_IDENTITY6 = np.eye(6)
+
+
+def _response_range(g, dV, C, L, U, nonlinear: bool, tangent: bool, f, K, lo: int, hi: int) -> None:
+    """Fill ``f[lo:hi]``, ``K[lo:hi]`` sub-block by sub-block (one thread's share)."""
+    from . import _jit  # Numba is imported on the first evaluation only (keeps CLI start-up fast)
+
+    q, a = g.shape[1], g.shape[2]
+    m = 3 * a
+    geo = tangent and nonlinear
+    for s in range(lo, hi, _SUB):
+        t = min(s + _SUB, hi)
+        nb = t - s
+        X = np.empty((nb, q, 6, a, 3) if tangent else (0, 0, 0, 0, 0))
+        GS = np.empty((nb, a, q, 3) if geo else (0, 0, 0, 0))
+        GT = np.empty_like(GS)
+        if L is not None:
+            Lf = L[s:t]
+        else:  # any factor works for f; for K the fallback below pairs B (C dV) with B
+            Lf = np.ascontiguousarray(C[s:t] * dV[s:t, :, None, None])
+        _jit.point_terms(g[s:t], dV[s:t], C[s:t], Lf, U[s:t], nonlinear, tangent, geo, f[s:t], X, GS, GT)
+        if not tangent:
+            continue
+        Xr = X.reshape(nb, 6 * q, m)
+        if L is not None:  # Xᵀ X: NumPy dispatches a matrix times its own transpose to BLAS syrk
+            np.matmul(Xr.transpose(0, 2, 1), Xr, out=K[s:t])
+        else:  # C dV not positive definite: K = Bᵀ (B C dV), B from the identity "factor"
+            B = np.empty_like(X)
+            _jit.point_terms(g[s:t], dV[s:t], C[s:t], np.ascontiguousarray(np.broadcast_to(_IDENTITY6, Lf.shape)),
+                             U[s:t], nonlinear, True, False, np.empty((nb, a, 3)), B, GS, GT)
+            np.matmul(B.reshape(nb, 6 * q, m).transpose(0, 2, 1), Xr, out=K[s:t])
+        if geo:
+            Kg = np.matmul(GS.reshape(nb, a, 3 * q), GT.reshape(nb, a, 3 * q).transpose(0, 2, 1))
+            _jit.add_geometric(K[s:t], Kg)
+
+
+def kernel_threads() -> int:
+    """Threads for the element kernel: ``LAYERSHELL_THREADS``, else ``NUMBA_NUM_THREADS`` /
+    ``OMP_NUM_THREADS`` (set to 1 by sweep workers), else the CPUs this process may use."""
+    for var in ("LAYERSHELL_THREADS", "NUMBA_NUM_THREADS", "OMP_NUM_THREADS"):
+        v = os.environ.get(var, "").strip()
+        if v.isdigit() and int(v) > 0:
+            return int(v)
+    try:
+        return max(1, len(os.sched_getaffinity(0)))
+    except AttributeError:  # pragma: no cover - not Linux
+        return max(1, os.cpu_count() or 1)
+
+
+_POOLS: dict[int, ThreadPoolExecutor] = {}
+_LOCK = threading.Lock()
+_BLAS = None
+
+
+def _pool(n: int) -> ThreadPoolExecutor:
+    with _LOCK:
+        if n not in _POOLS:
+            _POOLS[n] = ThreadPoolExecutor(n, thread_name_prefix="layershell-kernel")
+        return _POOLS[n]
+
+
+def _blas_single_thread():
+    """Context limiting BLAS to one thread (threadpoolctl) while the kernel runs: the per-element
+    products are small, BLAS threads inside them only add synchronisation (and on an oversubscribed
+    machine cost an order of magnitude). Restores the previous setting on exit."""
+    global _BLAS
+    with _LOCK:
+        if _BLAS is None:
+            from threadpoolctl import ThreadpoolController
+
+            _BLAS = ThreadpoolController()
+    return _BLAS.limit(limits=1, user_api="blas")
+
+
+def layer_response(
+    block: LayerBlock,
+    U: np.ndarray,
+    nonlinear: bool = True,
+    tangent: bool = True,
+    sl: slice = slice(None),
+):
+    """Internal force ``(e, a*3)`` and tangent ``(e, a*3, a*3)`` of a layer block (2.267)-(2.268).
+
+    ``U (e, a, 3)`` are the element's nodal director vectors; ``sl`` restricts to an
+    element range (for chunked assembly). Same results as :func:`layer_response_reference`
+    to round-off.
+    """
+    g, dV, C = (np.ascontiguousarray(x[sl], dtype=np.float64) for x in (block.gradphi, block.dV, block.C))
+    L = np.ascontiguousarray(block.L[sl]) if block.L is not None else None
+    U = np.ascontiguousarray(U, dtype=np.float64)
+    nonlinear, tangent = bool(nonlinear), bool(tangent)
+    e, _, a = g.shape[:3]
+    m = 3 * a
+    f = np.empty((e, a, 3))
+    K = np.empty((e, m, m)) if tangent else None
+    n_threads = min(kernel_threads(), max(1, e // _SUB))
+    with _blas_single_thread() if tangent else nullcontext():
+        if n_threads == 1:
+            _response_range(g, dV, C, L, U, nonlinear, tangent, f, K, 0, e)
+        else:
+            bounds = np.linspace(0, e, n_threads + 1).astype(int)
+            jobs = [_pool(n_threads).submit(_response_range, g, dV, C, L, U, nonlinear, tangent, f, K, lo, hi)
+                    for lo, hi in zip(bounds[:-1], bounds[1:])]
+            for j in jobs:
+                j.result()
+    return f.reshape(e, m), K

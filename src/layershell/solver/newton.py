@@ -96,7 +96,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     res = NewtonResult(False, 0)
     e0 = None
     for it in range(s.max_iterations + 1):
-        f, K = problem.assembler.evaluate(u, tangent=True)
+        # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
+        f, Kr = problem.assembler.evaluate_reduced(u, op)
         r = op.reduce(Fext - f)
         rn = float(np.linalg.norm(r))
         res.residuals.append(rn)
@@ -109,9 +110,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         if it == s.max_iterations:
             break
-        Kr = (op.T.T @ K @ op.T).tocsr()
         try:
-            du = linear.solve(Kr, r, s.backend)
+            du = problem.linear_solver(s.backend).solve(Kr, r)
         except linear.SingularSystemError as exc:
             res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
             return u, res
@@ -148,6 +148,19 @@ def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarr
     return dU
 
 
+@dataclass
+class DebondCut:
+    """Step cutting on large debonding jumps: if the re-solutions after one converged (sub)step
+    release more than ``max_fraction`` of the interface area, the increment is undone and
+    halved, at most ``max_cuts`` times per load step. The delamination state is then updated at
+    every converged sub-step, so the debonding front follows the load more closely and the result
+    depends less on the step size. ``measure(problem)`` gives the debonded fraction."""
+
+    max_fraction: float
+    max_cuts: int
+    measure: Callable[[Problem], float]
+
+
 def load_steps(
     problem: Problem,
     load_factors: np.ndarray,
@@ -156,33 +169,60 @@ def load_steps(
     lam0: float = 0.0,
     step0: int = 0,
     on_step_end: Callable[[Problem, np.ndarray, float], bool] | None = None,
+    cut: DebondCut | None = None,
 ) -> Iterator[StepResult]:
     """Generator over converged load steps to the target factors ``load_factors``.
 
     A diverging increment is bisected up to ``max_bisections`` times; converged substeps are
     not reported separately (the step is reported when its target factor is reached).
     ``on_step_end(problem, u, lam)`` may change the problem state (delamination) and returns
-    True when the same load level must be solved again.
+    True when the same load level must be solved again. Without ``cut`` it runs once the target
+    factor is reached; with ``cut`` (:class:`DebondCut`) after every converged sub-step, and a
+    sub-step that debonds too much at once is undone and halved.
     """
     s = settings or NewtonSettings()
     u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
     lam = lam0
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
-        total_it, bis = 0, 0
+        total_it, bis, cuts = 0, 0, 0
         residuals: list[float] = []
         inc = target - lam
         while True:
             trial = target if abs(target - (lam + inc)) <= 1e-12 * max(1.0, abs(target)) else lam + inc
+            snap = problem.snapshot() if cut is not None and on_step_end is not None else None
             u_new, res = newton(problem, u, trial, s)
             total_it += res.iterations
             residuals += res.residuals
+            if res.converged and snap is not None:
+                a0 = cut.measure(problem)
+                may_cut = cuts < cut.max_cuts and bis + cuts < s.max_bisections
+                while on_step_end(problem, u_new, trial):
+                    if may_cut and cut.measure(problem) - a0 > cut.max_fraction:
+                        res = NewtonResult(False, 0, message="debonding jump")
+                        break
+                    u_new, res = newton(problem, u_new, trial, s)
+                    total_it += res.iterations
+                    residuals += res.residuals
+                    if not res.converged:
+                        if may_cut:
+                            break
+                        raise ConvergenceError(
+                            f"step {n}: re-equilibration at load factor {trial:.6g} failed: {res.message}",
+                            trial, res.residuals[-1] if res.residuals else float("nan"))
+                if not res.converged:  # undo the increment and halve it
+                    problem.restore(snap)
+                    cuts += 1
+                    inc *= 0.5
+                    continue
             if res.converged:
                 u, lam = u_new, trial
                 if trial == target:
                     break
                 inc = min(inc, target - lam) if inc > 0 else max(inc, target - lam)
                 continue
+            if snap is not None:
+                problem.restore(snap)  # the failed Newton solve may have changed contact states
             bis += 1
             if bis > s.max_bisections:
                 raise ConvergenceError(
@@ -190,7 +230,7 @@ def load_steps(
                     f"bisections ({res.message}); the last converged load factor is {lam:.6g}",
                     trial, res.residuals[-1] if res.residuals else float("nan"))
             inc *= 0.5
-        if on_step_end is not None:
+        if on_step_end is not None and cut is None:
             while on_step_end(problem, u, lam):
                 u, res = newton(problem, u, lam, s)
                 total_it += res.iterations
@@ -199,4 +239,4 @@ def load_steps(
                     raise ConvergenceError(
                         f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}",
                         lam, res.residuals[-1] if res.residuals else float("nan"))
-        yield StepResult(n, lam, u.copy(), total_it, residuals, bis, time.perf_counter() - t0)
+        yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts, time.perf_counter() - t0)

@@ -1,0 +1,97 @@
+"""Compiled point loops of the layer kernel (Numba, ``cache=True``, GIL released).
+
+Imported lazily by :mod:`layershell.element.kernel` on the first evaluation. Equations: MODEL.md
+§5 / thesis (2.54), (2.249), (2.267)-(2.268); see ``kernel.py`` for the factored form.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_VMAP = np.array([[0, 5, 4], [5, 1, 3], [4, 3, 2]], dtype=np.int64)  # Voigt index of (J, K)
+
+
+@njit(cache=True, nogil=True)
+def point_terms(g, dV, C, L, U, nonlinear, want_x, want_geo, f, X, GS, GT):  # pragma: no cover
+    """Per point: strains, PK2 stress, internal force f (e, a, 3) and, on request, the factored
+    strain-displacement rows X (e, q, 6, a, 3) = B L and the geometric-term operands
+    GS = g S dV, GT = g, both (e, a, q, 3). L is the factor of C dV, or any (e, q, 6, 6) map."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    H = np.empty((3, 3))
+    F = np.empty((3, 3))
+    Ev = np.empty(6)
+    Sv = np.empty(6)
+    S = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Phi = np.empty((6, 3, 3))
+    for e in range(ne):
+        for a in range(na):
+            for i in range(3):
+                f[e, a, i] = 0.0
+        for q in range(nq):
+            for i in range(3):
+                for J in range(3):
+                    H[i, J] = 0.0
+            for a in range(na):
+                for i in range(3):
+                    u = U[e, a, i]
+                    for J in range(3):
+                        H[i, J] += u * g[e, q, a, J]
+            for I in range(3):
+                for J in range(3):
+                    F[I, J] = (1.0 if I == J else 0.0) + (H[I, J] if nonlinear else 0.0)
+            # Green-Lagrange strain (2.54), Voigt with engineering shear
+            for I in range(3):
+                for J in range(I, 3):
+                    s = 0.5 * (H[I, J] + H[J, I])
+                    if nonlinear:
+                        s += 0.5 * (H[0, I] * H[0, J] + H[1, I] * H[1, J] + H[2, I] * H[2, J])
+                    S[I, J] = s
+            Ev[0], Ev[1], Ev[2] = S[0, 0], S[1, 1], S[2, 2]
+            Ev[3], Ev[4], Ev[5] = 2.0 * S[1, 2], 2.0 * S[0, 2], 2.0 * S[0, 1]
+            w = dV[e, q]
+            for V in range(6):
+                s = 0.0
+                for W in range(6):
+                    s += C[e, q, V, W] * Ev[W]
+                Sv[V] = s * w
+            S[0, 0], S[1, 1], S[2, 2] = Sv[0], Sv[1], Sv[2]
+            S[1, 2] = S[2, 1] = Sv[3]
+            S[0, 2] = S[2, 0] = Sv[4]
+            S[0, 1] = S[1, 0] = Sv[5]
+            for K in range(3):
+                for i in range(3):
+                    P[K, i] = S[K, 0] * F[i, 0] + S[K, 1] * F[i, 1] + S[K, 2] * F[i, 2]
+            for a in range(na):
+                g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                for i in range(3):
+                    f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
+            if want_x:
+                for W in range(6):
+                    for K in range(3):
+                        for i in range(3):
+                            Phi[W, K, i] = (F[i, 0] * L[e, q, _VMAP[0, K], W] + F[i, 1] * L[e, q, _VMAP[1, K], W]
+                                            + F[i, 2] * L[e, q, _VMAP[2, K], W])
+                for W in range(6):
+                    for a in range(na):
+                        g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                        for i in range(3):
+                            X[e, q, W, a, i] = g0 * Phi[W, 0, i] + g1 * Phi[W, 1, i] + g2 * Phi[W, 2, i]
+            if want_geo:
+                for a in range(na):
+                    g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                    for K in range(3):
+                        GS[e, a, q, K] = g0 * S[0, K] + g1 * S[1, K] + g2 * S[2, K]
+                        GT[e, a, q, K] = g[e, q, a, K]
+
+
+@njit(cache=True, nogil=True)
+def add_geometric(K, Kg):  # pragma: no cover
+    """K[e, 3a+i, 3b+i] += Kg[e, a, b] (the δ_ik of (2.268))."""
+    ne, na = Kg.shape[0], Kg.shape[1]
+    for e in range(ne):
+        for a in range(na):
+            for b in range(na):
+                v = Kg[e, a, b]
+                for i in range(3):
+                    K[e, 3 * a + i, 3 * b + i] += v

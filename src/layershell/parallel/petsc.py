@@ -1,0 +1,327 @@
+"""Distributed solve of the reduced system with PETSc (petsc4py) and MPI (mpi4py).
+
+Every rank holds the model, the DOF map and the constraint operator T (replicated, built by the
+same functions as :meth:`layershell.solver.problem.Problem.build`), but evaluates only its
+contiguous element range with the serial kernel (:class:`.partition.LocalAssembly`). Its part of
+K_r = Tᵀ K T (3.69)-(3.72) is added into one PETSc MPIAIJ matrix whose rows are split in
+contiguous ranges; the matrix is preallocated exactly from the union of the ranks' reduced patterns
+(exchanged once with ``Alltoallv``), so no allocation happens during assembly. The reduced residual
+Tᵀ(λF - f_int) is a distributed PETSc vector. The default solver is KSP ``preonly`` + LU by MUMPS
+(direct, reproduces the serial solution to round-off); ``gamg`` gives CG + algebraic multigrid.
+The solution is gathered on every rank (``Scatter.toAll``) and expanded u = T u_r there.
+
+Run with ``mpiexec -n 2 python -m layershell.parallel MODEL.toml`` (docs/distributed.md).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..constraints import constraint_operator
+from ..dofs import number_dofs
+from ..loads import external_forces
+from ..model import Model
+from ..solver.newton import ConvergenceError, NewtonResult, NewtonSettings
+from .partition import LocalAssembly, element_ranges, element_weights
+
+SOLVERS = ("mumps", "gamg")
+
+
+class PetscUnavailableError(RuntimeError):
+    """petsc4py/mpi4py cannot be imported."""
+
+
+def find_petsc4py() -> None:
+    """Make Debian's petsc4py importable where ``PETSC_DIR`` is unset (its ``.pth`` file needs it):
+    append the newest ``/usr/lib/petscdir/*/*-real`` Python path. No-op where petsc4py imports."""
+    try:
+        import petsc4py  # noqa: F401
+    except ImportError:
+        import glob
+        import sys
+
+        found = sorted(glob.glob("/usr/lib/petscdir/petsc*/*-real/lib/python3/dist-packages"))
+        if found and found[-1] not in sys.path:
+            sys.path.append(found[-1])
+
+
+def unavailable_message(exc: Exception) -> str:
+    return (f"distributed runs need petsc4py and mpi4py built for this Python and NumPy ({exc}); on "
+            "Debian/Ubuntu: `apt-get install python3-petsc4py python3-mpi4py`, then run with a venv made "
+            "by `make test-mpi` or `/usr/bin/python3 -m venv --system-site-packages .venv-mpi` "
+            "(see docs/distributed.md)")
+
+
+def import_petsc():
+    """``(PETSc, MPI)`` or a clear error telling how to install them."""
+    find_petsc4py()
+    try:
+        from mpi4py import MPI
+        from petsc4py import PETSc
+    except (ImportError, ValueError) as exc:  # ValueError: petsc4py built for another NumPy
+        raise PetscUnavailableError(unavailable_message(exc)) from exc
+    return PETSc, MPI
+
+
+class SolveError(RuntimeError):
+    """The distributed linear solve failed (singular reduced tangent or no KSP convergence)."""
+
+
+class UnsupportedModelError(ValueError):
+    """The model uses a feature that distributed runs do not support yet."""
+
+
+def check_supported(model: Model) -> None:
+    """Raise :class:`UnsupportedModelError` for models the distributed solve cannot handle."""
+    if model.interface_laws:
+        raise UnsupportedModelError(
+            "distributed runs support bonded models only: remove the [[interfaces]] sections or run "
+            "serially with `layershell run` (delamination, contact and friction are not distributed "
+            "yet, see docs/distributed.md)")
+
+
+def row_ranges(n: int, size: int) -> np.ndarray:
+    """PETSc's default contiguous split of n rows over ``size`` ranks: boundaries (size + 1,)."""
+    per = np.full(size, n // size)
+    per[: n % size] += 1
+    return np.concatenate([[0], np.cumsum(per)]).astype(np.int64)
+
+
+@dataclass
+class Timings:
+    """Wall seconds of the phases, the maximum over the ranks."""
+
+    setup: float = 0.0  # local blocks, patterns, preallocation
+    assemble: float = 0.0  # kernel + insertion into PETSc (all evaluations)
+    solve: float = 0.0  # KSP solves (factorisation included)
+    gather: float = 0.0
+    setup_cpu: float = 0.0
+    assemble_cpu: float = 0.0  # CPU seconds of this process (meaningful on an oversubscribed machine)
+    solve_cpu: float = 0.0
+    evaluations: int = 0
+    extra: dict = field(default_factory=dict)
+
+
+class DistributedProblem:
+    """The static problem of a bonded model distributed over the ranks of ``comm``."""
+
+    def __init__(self, model: Model, solver: str = "mumps", comm=None):
+        check_supported(model)
+        if solver not in SOLVERS:
+            raise ValueError(f"unknown distributed solver {solver!r}; use one of {', '.join(SOLVERS)}")
+        PETSc, MPI = import_petsc()
+        t0, c0 = time.perf_counter(), time.process_time()
+        self.PETSc, self.MPI = PETSc, MPI
+        self.comm = comm if comm is not None else PETSc.COMM_WORLD
+        self.mpi = self.comm.tompi4py()
+        self.rank, self.size = self.comm.getRank(), self.comm.getSize()
+        self.model = model
+        self.dm = dm = number_dofs(model)
+        below = model.below()
+        bonded = {up: dm.present[up] & dm.present[lo] for up, lo in below.items()}
+        self.op = constraint_operator(model, dm, bonded)
+        self.F_scaled, self.F_const = external_forces(model, dm)
+        if model.mesh.elements.shape[0] < self.size:
+            raise UnsupportedModelError(f"{self.size} MPI ranks for {model.mesh.elements.shape[0]} elements: "
+                                        "start at most one rank per element (mpiexec -n)")
+        self.bounds = element_ranges(element_weights(model), self.size)
+        self.elements = np.arange(self.bounds[self.rank], self.bounds[self.rank + 1])
+        self.local = LocalAssembly(model, dm, self.op, self.elements)
+        n = self.op.n_red
+        self.rows = row_ranges(n, self.size)
+        self.lo, self.hi = int(self.rows[self.rank]), int(self.rows[self.rank + 1])
+        self.A = self._create_matrix()
+        self.b = self.A.createVecLeft()
+        self.x = self.A.createVecRight()
+        self._gather, self._x_all = PETSc.Scatter.toAll(self.x)
+        self.ksp = self._create_ksp(solver)
+        self.solver = solver
+        self._assembled = False
+        self.timings = Timings()
+        self.timings.setup = self._max(time.perf_counter() - t0)
+        self.timings.setup_cpu = self._max(time.process_time() - c0)
+
+    # --- setup -------------------------------------------------------------------------------
+    def _max(self, t: float) -> float:
+        return float(self.mpi.allreduce(t, op=self.MPI.MAX))
+
+    def _create_matrix(self):
+        """MPIAIJ matrix with the exact pattern: every rank sends its reduced entries (row, col)
+        to the row's owner, which counts the distinct diagonal-/off-diagonal-block columns."""
+        PETSc, MPI = self.PETSc, self.MPI
+        n = self.op.n_red
+        pat = self.local.pattern
+        key = pat.rows * n + pat.cols
+        owner = np.searchsorted(self.rows[1:], pat.rows, side="right")
+        order = np.argsort(owner, kind="stable")
+        send = np.ascontiguousarray(key[order], dtype=np.int64)
+        scount = np.bincount(owner, minlength=self.size).astype(np.int64)
+        rcount = np.empty(self.size, np.int64)
+        self.mpi.Alltoall(scount, rcount)
+        sdisp = np.concatenate([[0], np.cumsum(scount)[:-1]])
+        rdisp = np.concatenate([[0], np.cumsum(rcount)[:-1]])
+        recv = np.empty(int(rcount.sum()), np.int64)
+        self.mpi.Alltoallv([send, (scount, sdisp), MPI.INT64_T], [recv, (rcount, rdisp), MPI.INT64_T])
+        own = np.unique(recv)
+        r, c = own // n - self.lo, own % n
+        nloc = self.hi - self.lo
+        diag = (c >= self.lo) & (c < self.hi)
+        d_nnz = np.bincount(r[diag], minlength=nloc).astype(PETSc.IntType)
+        o_nnz = np.bincount(r[~diag], minlength=nloc).astype(PETSc.IntType)
+        self.nnz = int(self.mpi.allreduce(own.size))
+        A = PETSc.Mat().create(comm=self.comm)
+        A.setSizes(((nloc, n), (nloc, n)))
+        A.setType(PETSc.Mat.Type.AIJ)
+        A.setPreallocationNNZ((d_nnz, o_nnz))
+        A.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, True)
+        # the local contribution in CSR form over its distinct rows (pattern is sorted row-major)
+        urows, start = np.unique(pat.rows, return_index=True)
+        self._csr_rows = urows.astype(PETSc.IntType)
+        self._csr_ptr = np.concatenate([start, [pat.rows.size]]).astype(PETSc.IntType)
+        self._csr_cols = pat.cols.astype(PETSc.IntType)
+        self._red_dofs = self.local.red_dofs.astype(PETSc.IntType)
+        self._own = np.arange(self.lo, self.hi, dtype=PETSc.IntType)
+        return A
+
+    def _create_ksp(self, solver: str):
+        PETSc = self.PETSc
+        ksp = PETSc.KSP().create(comm=self.comm)
+        ksp.setOperators(self.A)
+        pc = ksp.getPC()
+        if solver == "mumps":
+            if not PETSc.Sys.hasExternalPackage("mumps"):
+                raise RuntimeError("this PETSc has no MUMPS; use solver='gamg'")
+            ksp.setType(PETSc.KSP.Type.PREONLY)
+            pc.setType(PETSc.PC.Type.LU)
+            pc.setFactorSolverType("mumps")
+        else:
+            ksp.setType(PETSc.KSP.Type.CG)
+            pc.setType(PETSc.PC.Type.GAMG)
+            ksp.setTolerances(rtol=1e-12, atol=0.0, max_it=5000)
+        ksp.setOptionsPrefix("ls_")
+        ksp.setFromOptions()  # -ls_ksp_type, -ls_pc_type, ... override from the command line
+        return ksp
+
+    # --- evaluation --------------------------------------------------------------------------
+    def reduced_external(self, lam: float) -> np.ndarray:
+        """Tᵀ(λ F_scaled + F_const) (replicated)."""
+        return self.op.reduce(lam * self.F_scaled + self.F_const)
+
+    def assemble(self, u_full: np.ndarray, lam: float, tangent: bool = True) -> None:
+        """b = Tᵀ(λF - f_int(u)) and (with ``tangent``) A = Tᵀ K(u) T, both distributed."""
+        PETSc = self.PETSc
+        t0, c0 = time.perf_counter(), time.process_time()
+        f_r, data = self.local.evaluate(u_full, tangent)
+        b = self.b
+        b.zeroEntries()
+        b.setValues(self._red_dofs, -f_r, addv=PETSc.InsertMode.ADD_VALUES)
+        b.setValues(self._own, self.reduced_external(lam)[self.lo:self.hi], addv=PETSc.InsertMode.ADD_VALUES)
+        b.assemblyBegin()
+        if tangent:
+            A = self.A
+            A.zeroEntries()
+            A.setValuesIJV(self._csr_ptr, self._csr_cols, data, addv=PETSc.InsertMode.ADD_VALUES,
+                           rowmap=self._csr_rows)
+            A.assemblyBegin()
+            A.assemblyEnd()
+            if not self._assembled:  # later assemblies send to the same ranks: cheaper exchange
+                A.setOption(PETSc.Mat.Option.SUBSET_OFF_PROC_ENTRIES, True)
+                self._assembled = True
+        b.assemblyEnd()
+        self.timings.assemble += time.perf_counter() - t0
+        self.timings.assemble_cpu += time.process_time() - c0
+        self.timings.evaluations += 1
+
+    def solve(self) -> np.ndarray:
+        """Solve A x = b (current assembly); the reduced solution on every rank."""
+        PETSc = self.PETSc
+        t0, c0 = time.perf_counter(), time.process_time()
+        try:
+            self.ksp.solve(self.b, self.x)
+        except PETSc.Error as exc:
+            raise SolveError(f"PETSc failed in the linear solve ({exc}); the reduced tangent may be "
+                             "singular (check that the supports prevent every rigid-body motion)") from exc
+        reason = self.ksp.getConvergedReason()
+        self.timings.solve += time.perf_counter() - t0
+        self.timings.solve_cpu += time.process_time() - c0
+        if reason < 0:
+            raise SolveError(f"PETSc KSP failed (reason {reason}); the reduced tangent may be singular "
+                             "(check that the supports prevent every rigid-body motion)")
+        t0 = time.perf_counter()
+        self._gather.scatter(self.x, self._x_all, addv=PETSc.InsertMode.INSERT_VALUES,
+                             mode=PETSc.ScatterMode.FORWARD)
+        out = self._x_all.getArray(readonly=True).copy()
+        self.timings.gather += time.perf_counter() - t0
+        return out
+
+    def residual_norm(self) -> float:
+        return float(self.b.norm())
+
+    # --- solves ------------------------------------------------------------------------------
+    def solve_linear(self, lam: float = 1.0, u_full: np.ndarray | None = None) -> np.ndarray:
+        """One linear solve K_r x = Tᵀ(λF - f_int(u)) at ``u`` (default 0): the linear solution for
+        ``nonlinear = false`` models, the first Newton correction otherwise."""
+        u = np.zeros(self.dm.n_full) if u_full is None else u_full
+        self.assemble(u, lam)
+        return self.solve()
+
+    def newton(self, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
+        """Equilibrium at ``lam`` from ``u`` (full space, replicated); the convergence test of
+        :func:`layershell.solver.newton.newton_fixed_set` (residual, or round-off floor with
+        negligible energy or correction), without line search (no contact here)."""
+        ref = float(np.linalg.norm(self.reduced_external(lam)))
+        res = NewtonResult(False, 0)
+        e0 = None
+        for it in range(s.max_iterations + 1):
+            self.assemble(u, lam)
+            rn = self.residual_norm()
+            res.residuals.append(rn)
+            if not np.isfinite(rn):
+                res.message = "residual is not finite"
+                return u, res
+            scale = ref if ref > 0 else 1e-300
+            if it > 0 and rn <= s.tol_residual * scale:
+                res.converged, res.iterations = True, it
+                return u, res
+            if it == s.max_iterations:
+                break
+            du = self.solve()
+            en = abs(float(self.x.dot(self.b)))
+            e0 = en if e0 is None else e0
+            dU = self.op.expand(du)
+            if (it > 0 and rn <= s.tol_floor * scale
+                    and (en <= s.tol_energy * e0
+                         or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300))):
+                res.converged, res.iterations = True, it
+                res.message = "converged at the round-off floor"
+                return u + dU, res
+            u = u + dU
+        res.iterations = s.max_iterations
+        res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
+        return u, res
+
+    def load_steps(self, load_factors, s: NewtonSettings | None = None) -> list[tuple[float, np.ndarray, int]]:
+        """Newton over the load factors (no bisection yet); ``[(λ, u_full, iterations), ...]``."""
+        s = s or NewtonSettings()
+        u = np.zeros(self.dm.n_full)
+        out = []
+        for lam in load_factors:
+            u, res = self.newton(u, float(lam), s)
+            if not res.converged:
+                raise ConvergenceError(f"distributed Newton: no convergence at load factor {lam:.6g} "
+                                       f"({res.message}); bisection is not implemented for MPI runs",
+                                       float(lam), res.residuals[-1])
+            out.append((float(lam), u.copy(), res.iterations))
+        return out
+
+    def finish_timings(self) -> Timings:
+        """Timings with every phase reduced to its maximum over the ranks."""
+        t = self.timings
+        return Timings(t.setup, self._max(t.assemble), self._max(t.solve), self._max(t.gather),
+                       t.setup_cpu, self._max(t.assemble_cpu), self._max(t.solve_cpu), t.evaluations, dict(t.extra))
+
+    def destroy(self) -> None:
+        for obj in (self.ksp, self.A, self.b, self.x, self._x_all, self._gather):
+            obj.destroy()

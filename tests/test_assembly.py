@@ -1,0 +1,140 @@
+"""Issue 6: the reduced-space scatter K_r.data = P @ K.data equals Tᵀ K T (3.69)-(3.72)."""
+import numpy as np
+import scipy.sparse as sp
+
+from layershell.assembly import ReducedScatter
+from layershell.delamination import InterfaceLaw
+from layershell.material import Orthotropic
+from layershell.mesh import rectangle
+from layershell.model import Fix, Hinge, Layer, Model, SurfaceLoad, Symmetry
+from layershell.solver import linear
+from layershell.solver.problem import Problem
+
+
+def _three_layers() -> Model:
+    """Three layers (d = 2, 3, 1), symmetry plane x = 0, hinge at x = 3, an interface law on the
+    upper interface (contact blocks) and that interface debonded for x < 1.6."""
+    mesh = rectangle(3.0, 1.0, 3, 2)
+    x = mesh.nodes
+    n = mesh.n_nodes
+    layers = [Layer("a", Orthotropic.isotropic(1e4, 0.25), 2, np.full(n, 0.2)),
+              Layer("b", Orthotropic(3.4e4, 3.6e4, 3.4e4, 1.5e4, 1.45e4, 1.45e4, 0.17, 0.17, 0.17), 3,
+                    0.1 + 0.02 * x[:, 0]),
+              Layer("c", Orthotropic.isotropic(2e4, 0.3), 1, np.full(n, 0.05))]
+    sym = np.flatnonzero(np.isclose(x[:, 0], 0))
+    hinge = np.flatnonzero(np.isclose(x[:, 0], 3))
+    corner = np.flatnonzero(np.isclose(x[:, 0], 0) & np.isclose(x[:, 1], 0))
+    m = Model(mesh, layers, [(0, 1, 2)], np.zeros(mesh.n_elements, int),
+              fixes=[Fix(corner, 0, (0,), (1,))],
+              symmetries=[Symmetry(sym, np.array([1.0, 0.0, 0.0]))],
+              hinges=[Hinge(hinge, np.tile([0.0, 0.0, 1.0], (len(hinge), 1)), None, fixed=False)],
+              surface_loads=[SurfaceLoad(np.arange(mesh.n_elements), "top", np.array([0, 0, -1.0]),
+                                         lambda x, y, z: 1.0 + 0 * x)])
+    m.interface_laws = {2: InterfaceLaw(1.0, 1.0, mu0=0.5)}
+    m.initially_debonded = {2: np.flatnonzero(x[:, 0] < 1.6)}
+    return m
+
+
+def _compare(pb, u):
+    f, K = pb.assembler.evaluate(u)
+    f2, Kr = pb.assembler.evaluate_reduced(u, pb.op)
+    T = pb.op.T
+    ref = (T.T @ K @ T).toarray()
+    assert Kr.shape == ref.shape and Kr.has_sorted_indices
+    assert np.array_equal(f, f2)
+    assert np.abs(Kr.toarray() - ref).max() <= 1e-12 * np.abs(ref).max()
+    # the pattern is structural: it contains every nonzero of Tᵀ K T and is symmetric
+    pat = sp.csr_matrix((np.ones(Kr.nnz), Kr.indices, Kr.indptr), shape=Kr.shape)
+    assert (abs(pat - pat.T)).nnz == 0
+    # the pattern maps give the same symmetry measure and upper triangle as the general path
+    plain = sp.csr_matrix(Kr.toarray() * (pat.toarray() > 0))
+    assert np.isclose(Kr.symmetry_error(), abs(plain - plain.T).max(), rtol=1e-12, atol=0)
+    assert linear.is_symmetric(Kr) == linear.is_symmetric(sp.csr_matrix(Kr.toarray()))
+    U = Kr.upper_triangle()
+    U0 = linear.PardisoSymmetric.upper(plain)
+    assert U.has_sorted_indices and np.all(np.diff(U.indptr) > 0)
+    assert np.array_equal(U.toarray(), np.triu(Kr.toarray()))
+    assert (U - U0).nnz == 0 or abs(U - U0).max() == 0
+    return Kr
+
+
+def test_reduced_scatter_equals_tT_K_T_with_symmetry_hinge_and_partial_debonding(rng):
+    pb = Problem.build(_three_layers())
+    assert pb.assembler.extra, "the interface law adds contact blocks"
+    assert not pb.bonded[2].all() and pb.bonded[2].any() and pb.bonded[1].all()
+    u = pb.op.expand(1e-2 * rng.standard_normal(pb.op.n_red))
+    Kr0 = _compare(pb, u)
+    rs = pb.assembler.reduced_scatter(pb.op)
+    assert pb.assembler.reduced_scatter(pb.op) is rs  # cached for the bond state
+    # another bond state (more debonded): a new operator, a new map, still exact
+    pb.bonded[2] = pb.bonded[2] & (pb.model.mesh.nodes[:, 1] > 0.4)
+    pb.rebuild_constraints()
+    Kr1 = _compare(pb, u)
+    assert pb.assembler.reduced_scatter(pb.op) is not rs
+    assert Kr1.shape[0] > Kr0.shape[0]  # debonding frees DOFs
+
+
+def test_reduced_scatter_general_operator(rng):
+    """A random operator with chained rows (up to 4 entries), empty rows (fixed DOFs) and
+    arbitrary weights against the sparse triple product."""
+    n, nr = 60, 45
+    A = sp.random(n, n, density=0.15, random_state=1, format="csr")
+    A = (A + A.T + sp.eye(n)).tocsr()
+    A.sort_indices()
+    rows = np.repeat(np.arange(n), rng.integers(0, 5, n))
+    T = sp.csr_matrix((rng.standard_normal(rows.size), (rows, rng.integers(0, nr, rows.size))), shape=(n, nr))
+    T.sum_duplicates()
+    data = rng.standard_normal(A.nnz)
+    K = sp.csr_matrix((data, A.indices, A.indptr), shape=A.shape)
+    ref = (T.T @ K @ T).toarray()
+    maps = [ReducedScatter(T, A.indptr, A.indices, jit=jit, chunk=37) for jit in (True, False)]  # compiled, NumPy
+    for rs in maps:
+        assert np.allclose(rs.matrix(data).toarray(), ref, rtol=0, atol=1e-13)
+        assert rs.mirror_pos is not None
+    a, b = maps
+    assert np.array_equal(a.indptr, b.indptr) and np.array_equal(a.indices, b.indices)
+    assert (a.P != b.P).nnz == 0
+
+
+def test_pattern_maps_detect_unsymmetric_values_and_fall_back(rng):
+    """A perturbed (unsymmetric, as with friction) K_r is reported unsymmetric; a matrix derived by
+    SciPy operations no longer uses the maps and takes the general path with the same result."""
+    pb = Problem.build(_three_layers())
+    _, Kr = pb.assembler.evaluate_reduced(pb.op.expand(1e-2 * rng.standard_normal(pb.op.n_red)), pb.op)
+    assert linear.is_symmetric(Kr) and Kr.symmetry_error() <= 1e-13 * np.abs(Kr.data).max()
+    K2 = Kr * 2.0
+    assert getattr(K2, "symmetry_error", lambda: None)() is None  # maps do not apply: general path
+    assert np.array_equal(linear.PardisoSymmetric.upper(K2).toarray(), np.triu(K2.toarray()))
+    assert linear.is_symmetric(K2)
+    rows = np.repeat(np.arange(Kr.shape[0]), np.diff(Kr.indptr))
+    off = np.flatnonzero(Kr.indices != rows)[0]
+    Kr.data[off] += 1e-6 * np.abs(Kr.data).max()
+    assert Kr.symmetry_error() >= 0.9e-6 * np.abs(Kr.data).max()
+    assert not linear.is_symmetric(Kr)
+
+
+def test_full_pattern_and_scatter_match_sorting_and_dense_assembly(rng):
+    """The compiled full-space pattern/scatter equals the sorting construction, and K equals a
+    dense element-by-element sum (with the contact blocks of the interface law)."""
+    from layershell.element.kernel import layer_response
+
+    pb = Problem.build(_three_layers())
+    A = pb.assembler
+    ref = (A.indptr.copy(), A.indices.copy(), A.scatter.copy())
+    u = pb.op.expand(1e-2 * rng.standard_normal(pb.op.n_red))
+    f, K = A.evaluate(u)
+    A._pattern_numpy([*A.blocks, *A.extra])
+    for x, y in zip(ref, (A.indptr, A.indices, A.scatter)):
+        assert np.array_equal(x, y)
+    n = pb.dm.n_full
+    Kd, fd = np.zeros((n, n)), np.zeros(n)
+    for b in A.blocks:
+        fe, Ke = layer_response(b.ref, u[b.dofs].reshape(b.dofs.shape[0], -1, 3), pb.model.nonlinear, True)
+        np.add.at(Kd, (b.dofs[:, :, None], b.dofs[:, None, :]), Ke)
+        np.add.at(fd, b.dofs, fe)
+    for b in A.extra:
+        fe, Ke = b.response(u)
+        np.add.at(Kd, (b.dofs[:, :, None], b.dofs[:, None, :]), Ke)
+        np.add.at(fd, b.dofs, fe)
+    assert np.abs(K.toarray() - Kd).max() <= 1e-12 * np.abs(Kd).max()
+    assert np.abs(f - fd).max() <= 1e-12 * np.abs(fd).max()

@@ -1,0 +1,59 @@
+"""Sparse linear solvers: PARDISO (symmetric indefinite, symbolic analysis reused) and SuperLU give
+the same solution as a dense solve; singular systems are reported, not returned."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from layershell.solver import linear
+
+BACKENDS = ["superlu"] + (["pardiso"] if linear.backend_name("auto") == "pardiso" else [])
+
+
+def _laplacian_2d(n: int, shift: float = 0.0) -> sp.csr_matrix:
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    return (sp.kron(T, sp.eye(n)) + sp.kron(sp.eye(n), T) - shift * sp.eye(n * n)).tocsr()
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("shift", [0.0, 1.3])  # SPD, and symmetric indefinite (eigenvalues < 0)
+def test_solution_matches_dense(backend, shift):
+    K = _laplacian_2d(12, shift)
+    r = np.random.default_rng(0).normal(size=K.shape[0])
+    x = linear.LinearSolver(backend).solve(K, r)
+    assert np.allclose(x, np.linalg.solve(K.toarray(), r), rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="pypardiso/MKL not available")
+def test_pardiso_reuses_analysis_and_reports_inertia():
+    s = linear.LinearSolver("pardiso")
+    K = _laplacian_2d(10)
+    r = np.ones(K.shape[0])
+    s.solve(K, r)
+    assert s.info.analysed and s.info.negative_pivots == 0
+    K2 = K.copy()
+    K2.data = K2.data * 1.7 + 0.0  # same pattern, new values: no new analysis, new factorisation
+    K2 = (K2 - 1.3 * 1.7 * sp.eye(K.shape[0])).tocsr()
+    K2.sort_indices()
+    x = s.solve(K2, r)
+    assert not s.info.analysed
+    assert np.allclose(K2 @ x, r, rtol=1e-9, atol=1e-10)
+    # negative eigenvalues of K2 = number of negative pivots (Sylvester's law of inertia)
+    assert s.info.negative_pivots == int((np.linalg.eigvalsh(K2.toarray()) < 0).sum()) > 0
+    K3 = _laplacian_2d(11)  # new pattern: analysed again
+    s.solve(K3, np.ones(K3.shape[0]))
+    assert s.info.analysed
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_singular_system_is_reported(backend):
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(30, 30)).tolil()
+    T[0, 0] = T[-1, -1] = 1.0  # free-free bar: rigid-body mode
+    with pytest.raises(linear.SingularSystemError):
+        linear.LinearSolver(backend).solve(T.tocsr(), np.linspace(1, 2, 30))
+
+
+def test_unknown_backend_is_rejected():
+    with pytest.raises(ValueError, match="unknown linear solver"):
+        linear.backend_name("umfpack")
