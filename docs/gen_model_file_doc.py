@@ -17,7 +17,15 @@ SECTIONS = [
     ("[model]", schema.ModelSettings, "General settings."),
     ("[mesh] type = \"rectangle\"", schema.RectangleMesh, "Flat rectangular plate in the x-y plane."),
     ("[mesh] type = \"cylinder\"", schema.CylinderMesh, "Cylindrical panel or ring sector."),
-    ("[mesh] type = \"revolution\"", schema.RevolutionMesh, "Shell of revolution about z from a meridian polyline."),
+    ("[mesh] type = \"revolution\"", schema.RevolutionMesh,
+     "Shell of revolution about z from a meridian through the points (meridian_r, meridian_z): a polyline "
+     "with n_meridian equal elements, or segments (straight or circular arcs) with their own element counts "
+     "and element sets. Node sets: first, last (the circles at the first/last meridian point), start, end "
+     "(the meridians at angle 0 and angle; open shells), and with segments meridian_point_0, 1, ... . "
+     "The first element coordinate line is the hoop direction (material axis 1 of a layer without "
+     "'direction')."),
+    ("segments = [{...}] (revolution mesh)", schema.MeridianSegment,
+     "One piece of the meridian between consecutive meridian points."),
     ("[mesh] type = \"file\"", schema.FileMesh, "A 9-node quadrilateral mesh read with meshio."),
     ("[materials.NAME] type = \"isotropic\"", schema.Isotropic, "Isotropic linear elastic material."),
     ("[materials.NAME] type = \"orthotropic\"", schema.OrthotropicMat,

@@ -93,13 +93,47 @@ def test_cfrp_debonded_zone_grows_with_the_load(cfrp):
 
 @pytest.mark.slow
 def test_cfrp_debonded_zone_is_longer_along_x2(cfrp):
-    """Thesis: the zone grows into an oval with the larger extent along x2. At the last step the
-    released points reach further along x2 than along x1, and both beyond the initial radius."""
+    """Thesis: the zone grows into an oval with the larger extent along x2. At the last step
+    (λ = 34) the released points reach x2 = 9.3 mm against x1 = 7.5 mm, both beyond the initial
+    radius of 5 mm.
+
+    Caveat (reported with the example): the x2 extent comes from a pair of nodes near the x2 axis
+    at x2 = 9 mm that fails separately, ahead of the main zone; the zone connected to the initial
+    circle reaches x1 = 7.5 and x2 = 6.3 mm, so the oval along x2 is reproduced only in this
+    weaker sense. This test checks the extents of all released points."""
     P = released_points(cfrp)
     ext1, ext2 = P[:, 0].max(), P[:, 1].max()
     assert ext2 > ext1 > 5.0
     assert ext2 > 1.15 * ext1
 
 
-# The TRC plate (§5.3.2, examples/trc_circular.toml) runs for many minutes; its checks are not in
-# the suite yet (see the closing note of issue 4).
+# ------------------------------------------------------------------ TRC plate (§5.3.2)
+@pytest.fixture(scope="module")
+def trc():
+    return run_example("trc_circular")
+
+
+@pytest.mark.slow
+def test_trc_onset_near_lambda_10_and_growth(trc):
+    """Thesis: the zone starts to grow at about λ = 10. The first failure is reported; with the
+    supports, the mesh and the face of f unknown (MODEL.md V8 gaps), a factor of 1.5 either way
+    is accepted. Here it comes at λ = 10, but at the supported corner (x1, x2) ≈ (180, 120) mm,
+    not at the initial zone (see the next test)."""
+    assert trc.converged, trc.message
+    a = areas(trc)
+    assert np.all(np.diff(a) >= 0)
+    assert a[-1] > a[0]
+    lam1 = trc.summary["first_delamination_load_factor"]
+    assert lam1 is not None and 10.0 / 1.5 <= lam1 <= 10.0 * 1.5
+
+
+@pytest.mark.slow
+def test_trc_initial_zone_grows_next_to_x2_axis(trc):
+    """Thesis: the growth of the initial zone (r = 50 mm) starts near (x1 = 0, x2 = 5 cm). At the
+    last step (λ = 15, where it starts here) points just outside the initial circle are released,
+    all on the x2 side."""
+    P = released_points(trc)
+    r = np.hypot(P[:, 0], P[:, 1])
+    near = P[(r > 50.0) & (r < 80.0)]
+    assert len(near) > 0
+    assert np.all(near[:, 1] > near[:, 0])

@@ -121,3 +121,25 @@ def test_slip_case_step_size_independence():
     a = run_example("cantilever_plate_slip").summary["probes"]["w_front_max"]
     b = run_example("cantilever_plate_slip", {"n = 24": "n = 48"}).summary["probes"]["w_front_max"]
     assert abs(a / b - 1) < 0.02
+
+
+def test_step_cutting_on_debonding_jumps():
+    """[delamination] max_debond_fraction: the first debonding step of the §5.1 plate releases a
+    large zone at once (a cascade of re-solutions). With the cap the step is undone and halved
+    (reported as bisections), the state is rolled back exactly (same result at the first step,
+    whose sub-steps debond nothing), release stays irreversible, and the zone at the end is
+    the same order as without cutting (the cascade is physical, it only starts from a closer
+    load level)."""
+    steps = {"n = 24": "factors = [0.5, 0.7]"}
+    plain = run_example("cantilever_plate_slip", steps)
+    cut = run_example("cantilever_plate_slip", {**steps, "[steps]": "[delamination]\nmax_debond_fraction = 0.02\n"
+                                                "max_debond_cuts = 3\n\n[steps]"})
+    assert plain.converged and cut.converged
+    a_plain = [a["concrete/trc"] for a in plain.summary["debonded_area"]]
+    a_cut = [a["concrete/trc"] for a in cut.summary["debonded_area"]]
+    assert a_plain[0] == a_cut[0] == 0.0
+    assert cut.summary["steps"][0]["probes"]["w_front_max"] == pytest.approx(
+        plain.summary["steps"][0]["probes"]["w_front_max"], rel=1e-12)
+    assert plain.summary["steps"][1]["bisections"] == 0
+    assert cut.summary["steps"][1]["bisections"] >= 1  # the jump was cut
+    assert a_cut[1] > 0 and 0.5 < a_cut[1] / a_plain[1] < 2.0

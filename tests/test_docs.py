@@ -32,3 +32,22 @@ def test_readme_shows_the_two_commands():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert "make demo" in text and "make test" in text
     assert os.access(ROOT / ".ci" / "run", os.X_OK)
+
+
+def test_user_guide_refers_to_existing_files():
+    """docs/user-guide.md is linked from the README, and every example, doc and output figure it
+    names exists / is written by the code (figure names checked against plots.write_figures)."""
+    guide = (ROOT / "docs" / "user-guide.md").read_text(encoding="utf-8")
+    assert "docs/user-guide.md" in (ROOT / "README.md").read_text(encoding="utf-8")
+    named = set(re.findall(r"examples/([\w.]+\.(?:toml|py|geo|msh))", guide))
+    named |= set(re.findall(r"`([\w]+\.(?:toml|geo|msh))`", guide))
+    named = {n for n in named if not n.split(".")[0].isupper()}  # placeholders: NAME.toml, MODEL.toml
+    assert len(named) > 15
+    for name in named:
+        assert (ROOT / "examples" / name).is_file(), name
+    for link in re.findall(r"\]\(([\w./-]+\.md)\)", guide):
+        assert (ROOT / "docs" / link).resolve().is_file(), link
+    plots = (ROOT / "src" / "layershell" / "plots.py").read_text(encoding="utf-8")
+    for png in ("deformed.png", "load_displacement.png", "load_debonded_area.png", "thickness_",
+                "load_displacement_", "debonded_zone_"):
+        assert png in guide and png in plots, png

@@ -206,3 +206,50 @@ def test_plot_through_thickness(tmp_path):
     p = tmp_path / "d" / "thick.png"
     plot_through_thickness(p, {"x=1": (np.array([1.0, 0.0, -1.0]), np.array([0.0, 0.05, 0.1]))}, "σ11")
     assert _is_png(p)
+
+
+def test_every_written_paraview_file_reads_back_cleanly(tmp_path, capfd):
+    """A run with delamination writes surface, solid and interface series; every .pvd lists
+    existing files in load order, and every .vtu reads back with meshio without a warning (meshio
+    prints its warnings to stderr), with finite data of the right length on the right cell type."""
+    import warnings
+
+    from test_figures import SUCTION
+
+    from layershell.io.build import build, parse
+    from layershell.runner import run
+
+    spec = build(parse(SUCTION.replace("vtu = false", "vtu = true"), "suction.toml"), tmp_path)
+    out = tmp_path / "out"
+    res = run(spec, out)
+    assert res.converged
+    capfd.readouterr()
+    pvds = sorted(p.name for p in out.glob("*.pvd"))
+    assert pvds == ["interface_base_top.pvd", "solid.pvd", "surface.pvd"]
+    cell_type = {"surface": "quad9", "solid": "hexahedron", "interface_base_top": "quad9"}
+    listed = set()
+    for name in pvds:
+        root = ET.parse(out / name).getroot()
+        assert root.tag == "VTKFile" and root.attrib["type"] == "Collection"
+        ds = root.findall("./Collection/DataSet")
+        assert [float(d.attrib["timestep"]) for d in ds] == [0.5, 1.0]
+        for d in ds:
+            f = out / d.attrib["file"]
+            listed.add(f.name)
+            with warnings.catch_warnings():
+                warnings.simplefilter("error")
+                m = meshio.read(f)
+            assert capfd.readouterr().err == "", f.name
+            n = len(m.points)
+            assert n > 0 and np.all(np.isfinite(m.points))
+            assert [c.type for c in m.cells] == [cell_type[name[:-4]]]
+            for key, arr in m.point_data.items():
+                assert len(arr) == n and np.all(np.isfinite(arr)), (f.name, key)
+            for key, blocks in m.cell_data.items():
+                assert [len(b) for b in blocks] == [len(c.data) for c in m.cells], (f.name, key)
+            assert m.cells[0].data.max() < n
+    assert listed == {p.name for p in out.glob("*.vtu")}  # no file outside a series
+    # the interface state matches the run: intact at λ = 0.5, all debonded at λ = 1
+    flags = [meshio.read(out / f"interface_base_top_{s:04d}.vtu").point_data["debonded"] for s in (1, 2)]
+    assert flags[0].max() == 0 and flags[1].min() == 1
+    assert [a["base/top"] for a in res.summary["debonded_area"]] == pytest.approx([0.0, 2.0])

@@ -1,13 +1,17 @@
-"""Command line: ``layershell run | check``. Bad input ends with one paragraph and exit code 2.
+"""Command line: ``layershell run | check | report | sweep | calibrate``. Bad input ends with one
+paragraph and exit code 2.
 
 Exit codes: 0 success; 1 the solution failed (no convergence) or an internal error; 2 bad input
-(model file, supports, command-line arguments). Set ``LAYERSHELL_TRACEBACK=1`` to see the Python
-traceback of an unexpected error instead of the one-paragraph message.
+(model file, supports, command-line arguments, a restart folder of another model); 130 stopped by
+Ctrl-C (the converged steps are written; continue with ``--restart``). Set
+``LAYERSHELL_TRACEBACK=1`` to see the Python traceback of an unexpected error instead of the
+one-paragraph message.
 """
 from __future__ import annotations
 
 import os
 import sys
+import warnings
 from pathlib import Path
 from typing import NoReturn
 
@@ -36,7 +40,10 @@ def _load(model: Path):
     from .io.build import InputError, load
 
     try:
-        return load(model)
+        spec = load(model)
+        for note in spec.model.mesh.notes:  # e.g. quad4/quad8 converted to quad9
+            err.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+        return spec
     except InputError as exc:
         _fail(str(exc))
     except Exception as exc:  # last line of defence: never a traceback
@@ -145,43 +152,72 @@ def check(model: Path = typer.Argument(..., help="model file (TOML)")):
 @app.command()
 def run(
     model: Path = typer.Argument(..., help="model file (TOML)"),
-    out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>)"),
+    out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>, "
+                                 "with --restart the folder restarted from)"),
     no_vtu: bool = typer.Option(False, "--no-vtu", help="skip the ParaView files"),
     quiet: bool = typer.Option(False, "--quiet", "-q"),
+    restart: Path = typer.Option(None, "--restart", help="continue a stopped run from the last converged step "
+                                 "saved in this results folder (checkpoint.npz)"),
 ):
-    """Solve a model and write summary.json, probes.csv, ParaView files and plots."""
+    """Solve a model and write summary.json, probes.csv, ParaView files and plots.
+
+    Every converged step is written at once (with the restart file checkpoint.npz); Ctrl-C stops
+    cleanly after the converged steps (exit code 130), and ``--restart DIR`` continues from there.
+    """
     spec = _load(model)
+    from .checkpoint import CheckpointError
     from .constraints import ConstraintError
     from .formula import FormulaError
     from .runner import run as run_model
 
+    if restart is not None and out_dir is None:
+        out_dir = restart if restart.is_dir() else restart.parent
     out_dir = out_dir or Path("results") / model.stem
     if out_dir.exists() and not out_dir.is_dir():
         _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    with Progress(TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("λ = {task.fields[lam]:.4g}"),
-                  TimeElapsedColumn(), console=err, disable=quiet, transient=False) as prog:
-        task = prog.add_task(escape(model.stem), total=len(spec.load_factors), lam=0.0)
-        failure: tuple[str, int] | None = None
-        try:
-            res = run_model(spec, out_dir, lambda i, n, lam: prog.update(task, completed=i, lam=lam),
-                            write_vtu=False if no_vtu else None)
-        except ConstraintError as exc:
-            failure = (f"{model}: 'supports': {exc}", 2)
-        except FormulaError as exc:
-            failure = (f"{model}: a formula or value in the model file cannot be evaluated ({exc}); "
-                       "check the load magnitudes and distributions", 2)
-        except OSError as exc:
-            failure = (f"cannot write the results to '{out_dir}': {exc.strerror or exc}; "
-                       "choose another folder with --out", 2)
-        except Exception as exc:
-            if _traceback_wanted():
-                raise
-            failure = (f"{model}: the solution stopped with an internal error ({type(exc).__name__}: {exc}); "
-                       "set LAYERSHELL_TRACEBACK=1 to see where, and report it with the model file", 1)
+    failure: tuple[str, int] | None = None
+    try:
+        with Progress(TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("λ = {task.fields[lam]:.4g}"),
+                      TimeElapsedColumn(), console=err, disable=quiet, transient=False) as prog:
+            task = prog.add_task(escape(model.stem), total=len(spec.load_factors), lam=0.0)
+            try:
+                with warnings.catch_warnings(record=True) as caught:  # numerical warnings: one note below
+                    warnings.simplefilter("default")
+                    res = run_model(spec, out_dir, lambda i, n, lam: prog.update(task, completed=i, lam=lam),
+                                    write_vtu=False if no_vtu else None, restart=restart)
+            except CheckpointError as exc:
+                failure = (f"{model}: {exc}", 2)
+            except ConstraintError as exc:
+                failure = (f"{model}: 'supports': {exc}", 2)
+            except FormulaError as exc:
+                failure = (f"{model}: a formula or value in the model file cannot be evaluated ({exc}); "
+                           "check the load magnitudes and distributions", 2)
+            except OSError as exc:
+                failure = (f"cannot write the results to '{out_dir}': {exc.strerror or exc}; "
+                           "choose another folder with --out", 2)
+            except MemoryError:
+                failure = (f"{model}: the model needs more memory than this computer has; use a coarser mesh, "
+                           "fewer layers or fewer directors", 2)
+            except Exception as exc:
+                if _traceback_wanted():
+                    raise
+                failure = (f"{model}: the solution stopped with an internal error ({type(exc).__name__}: {exc}); "
+                           "the converged steps are in summary.json; set LAYERSHELL_TRACEBACK=1 to see where, and "
+                           "report it with the model file", 1)
+    except KeyboardInterrupt:  # before the first load step (building the problem)
+        failure = (f"{model}: interrupted by the user before the first load step; nothing was solved", 130)
     if failure is not None:
         _fail(*failure)
+    numeric = [w for w in caught if issubclass(w.category, RuntimeWarning)]
+    for w in caught:  # other warnings as usual
+        if not issubclass(w.category, RuntimeWarning):
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno)
+    if numeric and res.converged:  # a failed run explains itself; a converged one may hold NaN values
+        first = " ".join(str(numeric[0].message).split())
+        err.print(f"warning: {len(numeric)} numerical warning(s) during the solution (first: {escape(first)}); check "
+                  "summary.json and probes.csv for NaN or infinite values", soft_wrap=True, highlight=False)
     s = res.summary
     if not quiet:
         for k, v in s["probes"].items():
@@ -190,16 +226,21 @@ def run(
                   f"{s['wall_seconds']:.2f} s — results in {out_dir}/ (summary.json, probes.csv, *.vtu, *.pvd)",
                   soft_wrap=True, highlight=False)
     if not res.converged:
-        _report_failure(model, res)
+        _report_failure(model, res, out_dir)
 
 
-def _report_failure(model: Path, res) -> None:
-    """One paragraph for a solve that did not converge: free rigid-body motions are bad input (2)."""
+def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
+    """One paragraph for a run that stopped early: Ctrl-C (exit code 130) with the restart command;
+    free rigid-body motions are bad input (2); other non-convergence names the step, the load
+    factor and the last residual (1). The converged steps are kept in every case."""
     msg = res.message.rstrip(".")
-    if "interrupted" in msg:
-        _fail(msg, 1)
-    kept = ("the converged steps are in summary.json and probes.csv" if res.summary.get("steps")
-            else "no load step converged")
+    where = f"'{out_dir}'" if out_dir is not None else "the results folder"
+    if getattr(res, "interrupted", False) or "interrupted" in msg:
+        again = (f"; continue with: layershell run {model} --restart {out_dir}" if out_dir is not None
+                 and res.summary.get("steps") else "")
+        _fail(f"{model}: {msg}; summary.json and probes.csv in {where} hold them{again}", 130)
+    kept = (f"the {len(res.summary['steps'])} converged step(s) are kept in summary.json and probes.csv in {where}"
+            if res.summary.get("steps") else "no load step converged")
     modes = _rigid_body_modes(res.problem)
     if modes:
         _fail(f"{model}: 'supports': the supports leave {len(modes)} rigid-body motion(s) free "
@@ -215,6 +256,127 @@ def _report_failure(model: Path, res) -> None:
                  "they do, the load may pass a limit point or be too large for one step: use more load steps "
                  "([steps] n), a smaller lambda_end, or larger max_iterations / max_bisections")
     _fail(f"{model}: the solution failed: {msg}; {cause}; {kept}", 1)
+
+
+def _guarded(what: str, fn, *args, **kwargs):
+    """Call ``fn``: InputError → one paragraph, exit 2; other errors → exit 1 (no traceback)."""
+    from .io.build import InputError
+
+    try:
+        return fn(*args, **kwargs)
+    except InputError as exc:
+        _fail(str(exc))
+    except OSError as exc:
+        _fail(f"{what}: cannot read or write '{getattr(exc, 'filename', '') or ''}': {exc.strerror or exc}; "
+              "check the paths and choose another folder with --out", 2)
+    except Exception as exc:
+        if _traceback_wanted():
+            raise
+        _fail(f"{what} stopped with an internal error ({type(exc).__name__}: {exc}); set LAYERSHELL_TRACEBACK=1 "
+              "to see where, and report it with the model file", 1)
+
+
+@app.command()
+def report(
+    results: Path = typer.Argument(..., help="results folder written by run, sweep or calibrate"),
+    out_file: Path = typer.Option(None, "--out", "-o", help="HTML file to write (default DIR/report.html)"),
+    model: Path = typer.Option(None, "--model", help="the model file, named in the report"),
+):
+    """Write a self-contained HTML report (tables and embedded figures) of a results folder."""
+    from .report import write_report
+
+    path = _guarded(f"report of '{results}'", write_report, results, out_file, model)
+    out.print(f"report written to {path}", highlight=False, soft_wrap=True)
+
+
+@app.command()
+def sweep(
+    model: Path = typer.Argument(..., help="model file (TOML)"),
+    sets: list[str] = typer.Option(..., "--set", help="KEY=V1,V2,... with a dotted model-file path as KEY, e.g. "
+                                   "interfaces.0.tau_max=1.0,1.2; several --set give the Cartesian product"),
+    out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>_sweep)"),
+    jobs: int = typer.Option(None, "--jobs", "-j", min=1, help="parallel processes (default: number of cores)"),
+    vtu: bool = typer.Option(False, "--vtu", help="also write the ParaView files of every variant"),
+    quiet: bool = typer.Option(False, "--quiet", "-q"),
+):
+    """Run variants of a model in parallel and tabulate their final probes (sweep.csv).
+
+    Exit code 0 when every variant converged, 1 when some did not (they are rows with an error),
+    2 for bad input (a path or value that does not fit the model file)."""
+    from rich.table import Table
+
+    from .sweep import parse_assignment
+    from .sweep import sweep as run_sweep
+
+    pairs = [_guarded("--set", parse_assignment, a) for a in sets]
+    out_dir = out_dir or Path("results") / f"{model.stem}_sweep"
+    if out_dir.exists() and not out_dir.is_dir():
+        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+
+    def progress(rec):
+        if not quiet:
+            state = "ok" if rec["converged"] else "FAILED"
+            err.print(f"variant {rec['index']}: {escape(str(rec['values']))} {state} ({rec.get('wall_seconds')} s)",
+                      highlight=False, soft_wrap=True)
+
+    res = _guarded(f"sweep of {model}", run_sweep, model, pairs, out_dir, jobs, vtu, progress)
+    if not quiet:
+        table = Table(title=f"{model.name}: {len(res.rows)} variant(s) — {res.out / 'sweep.csv'}")
+        shown = [h for h in res.header if h not in ("folder", "error", "wall_seconds")]
+        for h in shown:
+            table.add_column(escape(h), justify="left" if h == "variant" else "right", overflow="fold")
+        idx = [res.header.index(h) for h in shown]
+        for r in res.rows:
+            table.add_row(*[escape(f"{r[i]:.6g}" if isinstance(r[i], float) else str(r[i])) for i in idx])
+        out.print(table)
+        for r in res.rows:
+            if r[-1]:
+                err.print(f"{r[0]}: {escape(str(r[-1]))}", highlight=False, soft_wrap=True)
+    if res.failed:
+        _fail(f"{res.failed} of {len(res.rows)} variant(s) did not converge; see the 'error' column of "
+              f"{res.out / 'sweep.csv'} and their folders", 1)
+
+
+@app.command()
+def calibrate(
+    model: Path = typer.Argument(..., help="model file (TOML); its values are the start unless given"),
+    data: Path = typer.Option(..., "--data", help="measured curve: CSV file with a header row"),
+    x: str = typer.Option("load_factor", "--x", help="column of the data and model quantity on the x axis: "
+                          "load_factor, a probe name, debonded_area[:interface]"),
+    y: str = typer.Option(..., "--y", help="column of the data and model quantity on the y axis"),
+    params: list[str] = typer.Option(..., "--param", help="KEY=LOWER:UPPER[:START], a dotted model-file path "
+                                     "and its bounds, e.g. interfaces.0.tau_max=1.0:3.0"),
+    out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>_calibration)"),
+    method: str = typer.Option("auto", "--method", help="auto (bounded Brent for one parameter, least_squares "
+                               "for several), bounded or least_squares"),
+    max_runs: int = typer.Option(40, "--max-runs", help="most model runs"),
+    xtol: float = typer.Option(1e-3, "--xtol", help="tolerance on the parameters, fraction of the bound range"),
+    no_best_run: bool = typer.Option(False, "--no-best-run", help="do not re-run the best parameters into OUT/best"),
+    quiet: bool = typer.Option(False, "--quiet", "-q"),
+):
+    """Fit model-file parameters to a measured curve (bounded SciPy optimisation of the RMS difference)."""
+    from .calibrate import calibrate as run_calibration
+    from .calibrate import parse_param
+
+    plist = [_guarded("--param", parse_param, a) for a in params]
+    out_dir = out_dir or Path("results") / f"{model.stem}_calibration"
+    if out_dir.exists() and not out_dir.is_dir():
+        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+
+    def progress(rec):
+        if not quiet:
+            vals = ", ".join(f"{k}={v:.6g}" for k, v in rec["values"].items())
+            err.print(f"run: {escape(vals)} → RMS {rec['objective']:.6g}"
+                      + (f" ({escape(rec['error'])})" if rec["error"] else ""), highlight=False, soft_wrap=True)
+
+    res = _guarded(f"calibration of {model}", run_calibration, model, data, x, y, plist, out_dir, method,
+                   max_runs, xtol, not no_best_run, progress)
+    if not quiet:
+        for k, v in res.best.items():
+            out.print(f"  {k:32s} = {v: .6g}", highlight=False)
+        out.print(f"RMS {res.objective_start:.6g} at the start → {res.objective:.6g} after {res.evaluations} model "
+                  f"run(s) ({res.method}: {res.message}) — {out_dir}/calibration.json, calibration.png",
+                  highlight=False, soft_wrap=True)
 
 
 def main() -> None:  # console-script entry point

@@ -26,6 +26,7 @@ class Mesh:
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
     element_sets: dict[str, np.ndarray] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    node_fields: dict[str, np.ndarray] = field(default_factory=dict)  # named nodal values, (n_nodes,)
 
     @property
     def n_nodes(self) -> int:
@@ -48,26 +49,123 @@ class Mesh:
         perm = np.array([1, 0, 3, 2, 4, 7, 6, 5, 8])
         self.elements[mask] = self.elements[mask][:, perm]
 
+    #: smallest allowed ratio min/max of the signed area Jacobian over an element's 3×3 Gauss points
+    MIN_JACOBIAN_RATIO = 0.05
+
+    def jacobians(self) -> tuple[np.ndarray, np.ndarray]:
+        """Signed area Jacobians (A1 × A2) · N_c of every element (2.10), with N_c the unit normal
+        at the element centre: at the 3×3 Gauss points ``(e, 9)`` and at the 9 nodes ``(e, 9)``.
+        Positive everywhere for a valid element; a sign change means the element folds over."""
+        from .element.quadrature import gauss_2d
+        from .element.shape import quad9
+
+        X = self.nodes[self.elements]  # (e, 9, 3)
+
+        def cross(xi, eta):
+            _, dN, _ = quad9(xi, eta)  # (q, 9, 2)
+            A = np.einsum("qna,eni->eqai", dN, X)
+            return np.cross(A[:, :, 0], A[:, :, 1])  # (e, q, 3)
+
+        nc = cross(np.zeros(1), np.zeros(1))[:, 0]
+        nrm = np.linalg.norm(nc, axis=1)
+        nc = nc / np.where(nrm > 0, nrm, 1.0)[:, None]
+        pts, _ = gauss_2d(3)
+        jg = np.einsum("eqi,ei->eq", cross(pts[:, 0], pts[:, 1]), nc)
+        jn = np.einsum("eqi,ei->eq", cross(NODE_XI[:, 0], NODE_XI[:, 1]), nc)
+        return jg, jn
+
+    def inconsistent_orientation(self) -> np.ndarray:
+        """Ids of elements whose node order (normal A3) is reversed relative to their neighbours.
+
+        Two elements sharing an edge must run along it in opposite directions. In every connected
+        patch the orientation shared by the larger number of elements is taken as right; the
+        others are returned (sorted). Edges shared by more than two elements are ignored."""
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        ne = self.n_elements
+        if ne < 2:
+            return np.zeros(0, np.int64)
+        corners = self.elements[:, :4]
+        a = corners.ravel()
+        b = np.roll(corners, -1, axis=1).ravel()
+        el = np.repeat(np.arange(ne), 4)
+        keep = a != b  # collapsed edges (poles) carry no orientation
+        a, b, el = a[keep], b[keep], el[keep]
+        key = np.stack([np.minimum(a, b), np.maximum(a, b)], 1)
+        _, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+        inv = inv.ravel()
+        order = np.argsort(inv, kind="stable")
+        shared = cnt[inv[order]] == 2
+        pair = order[shared].reshape(-1, 2)  # the two edge uses of every edge shared by two elements
+        e1, e2 = el[pair[:, 0]], el[pair[:, 1]]
+        same = a[pair[:, 0]] == a[pair[:, 1]]  # both run the same way: orientations disagree
+        # double cover: vertex 2e = element e as given, 2e + 1 = element e flipped
+        s1 = np.concatenate([2 * e1, 2 * e1 + 1])
+        s2 = np.concatenate([2 * e2 + same, 2 * e2 + 1 - same])
+        g = coo_matrix((np.ones(s1.size), (s1, s2)), shape=(2 * ne, 2 * ne))
+        _, lab = connected_components(g, directed=False)
+        as_given, flipped = lab[0::2], lab[1::2]
+        ok = as_given != flipped  # False on a non-orientable patch (Möbius strip): nothing to say
+        votes = np.bincount(as_given[ok], minlength=lab.max() + 1)
+        # a patch appears twice in the cover (as given / flipped); the larger class wins
+        bad = ok & (votes[as_given] < votes[flipped])
+        tie = ok & (votes[as_given] == votes[flipped]) & (as_given > flipped)
+        return np.flatnonzero(bad | tie)
+
     def check(self) -> None:
-        """Reject inverted or degenerate elements, naming them and their Jacobians."""
+        """Reject inverted or badly distorted elements, naming them and their Jacobians.
+
+        Rejected are elements (i) whose node order is reversed relative to their neighbours
+        (:meth:`inconsistent_orientation`), (ii) whose signed area Jacobian (2.10) at the 3×3 Gauss
+        points and the nodes has min/max below :attr:`MIN_JACOBIAN_RATIO` (negative: folded, e.g. a
+        misplaced mid-side node; small: a corner angle near 180° or a squeezed element), (iii) whose
+        normal turns by more than 60° within the element. Nodes of a collapsed edge (a pole of a
+        shell of revolution, zero Jacobian by construction) are left out of (ii).
+        """
         e = self.elements
         if e.ndim != 2 or e.shape[1] != 9:
             raise MeshError(f"elements must have 9 nodes each, got shape {e.shape}")
         if e.min() < 0 or e.max() >= self.n_nodes:
             raise MeshError("element connectivity refers to nodes that do not exist")
+        flipped = self.inconsistent_orientation()
+        if flipped.size:
+            b = flipped[:10]
+            with np.errstate(invalid="ignore", divide="ignore"):
+                jg, _ = self.jacobians()
+            detail = "; ".join(f"element {i}: Jacobian {-jg[i].max():.4g} to {-jg[i].min():.4g}" for i in b)
+            raise MeshError(
+                f"{flipped.size} element(s) are inverted (node order reversed relative to their neighbours, "
+                f"so their normal points the other way): ids {b.tolist()}{' ...' if flipped.size > 10 else ''} "
+                f"({detail}, signed area Jacobians (2.10) at the Gauss points relative to the neighbours' "
+                "orientation); reverse their node order (Gmsh: 'ReverseMesh Surface {...};' or consistently "
+                "oriented curve loops) so that all normals point into the material"
+            )
         from .element.quadrature import gauss_2d
 
-        pts, _ = gauss_2d(3)
-        sp = surface_points(self.nodes[e], pts[:, 0], pts[:, 1])
-        ref = self.normals_at_centres()
-        cosang = np.einsum("eqi,ei->eq", sp.A3, ref)
-        jac = sp.sqrtA
-        bad = np.where((jac.min(1) <= 1e-12 * jac.max()) | (cosang.min(1) < 0.5))[0]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            jg, jn = self.jacobians()
+            X = self.nodes[e]
+            dist = np.linalg.norm(X[:, :, None] - X[:, None, :], axis=-1)  # (e, 9, 9)
+            collapsed = (dist < 1e-9 * self.size()).sum(2) > 1  # nodes of a collapsed edge (pole)
+            jn = np.where(collapsed, np.inf, jn)
+            jmax = np.maximum(jg.max(1), np.where(collapsed, -np.inf, jn).max(1))
+            jmin = np.minimum(jg.min(1), jn.min(1))
+            ratio = np.where(jmax > 0, jmin / np.where(jmax > 0, jmax, 1.0), -np.inf)
+            pts, _ = gauss_2d(3)
+            sp = surface_points(self.nodes[e], pts[:, 0], pts[:, 1])
+            cosang = np.nan_to_num(np.einsum("eqi,ei->eq", sp.A3, self.normals_at_centres()), nan=-1.0)
+        bad = np.flatnonzero((ratio < self.MIN_JACOBIAN_RATIO) | (cosang.min(1) < 0.5))
         if bad.size:
+            b = bad[:10]
+            detail = "; ".join(f"element {i}: Jacobian min {jmin[i]:.4g}, max {jmax[i]:.4g}, min/max {ratio[i]:.3g}"
+                               for i in b)
             raise MeshError(
-                f"{bad.size} element(s) are inverted or badly distorted: ids {bad[:10].tolist()}"
-                f"{' ...' if bad.size > 10 else ''}; area Jacobians {np.round(jac[bad[:10]].min(1), 6).tolist()}"
-                "; fix the node order or the element shape"
+                f"{bad.size} element(s) are inverted or badly distorted: ids {b.tolist()}"
+                f"{' ...' if bad.size > 10 else ''} ({detail}); the signed area Jacobian (2.10) must stay "
+                f"positive with min/max ≥ {self.MIN_JACOBIAN_RATIO} over each element (Gauss points and nodes): "
+                "fix the node order or the element shape (move misplaced mid-side or centre nodes, avoid corner "
+                "angles near 0° or 180°)"
             )
 
 
@@ -136,29 +234,116 @@ def cylinder(radius: float, angle_start: float, angle_end: float, width: float, 
     return _orient(mesh, want)
 
 
-def revolution(meridian_r, meridian_z, n_meridian: int, n_circ: int, angle: float = 360.0,
-               normal: str = "inward") -> Mesh:
-    """Shell of revolution about the z axis from a meridian polyline (r_k, z_k).
+@dataclass(frozen=True)
+class MeridianSegment:
+    """One piece of a meridian between two consecutive meridian points: ``elements`` elements
+    along it, an optional element-set ``name``, and an optional ``arc_center`` (r_c, z_c) that
+    makes it the shorter circular arc about that centre (default: a straight line)."""
 
-    The meridian is resampled by arc length to ``2 n_meridian + 1`` points. ``normal``
-    'inward' or 'outward' relative to the axis (for a dome with the reference surface on the
-    inner face use 'outward'). Node sets: 'first'/'last' (the circles at the first and last
-    meridian point), 'start'/'end' (the meridians at angle 0 and ``angle``; merged when closed).
+    elements: int
+    name: str | None = None
+    arc_center: tuple[float, float] | None = None
+
+
+def _meridian_nodes(r: np.ndarray, z: np.ndarray, segments: list[MeridianSegment],
+                    thickness: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Node positions (r, z) along a segmented meridian (2 n_k + 1 nodes per segment, shared end
+    points) and the thickness interpolated linearly in the segment parameter (arc length)."""
+    rs, zs, hs = [], [], []
+    for k, seg in enumerate(segments):
+        u = np.linspace(0.0, 1.0, 2 * seg.elements + 1)
+        if k > 0:
+            u = u[1:]
+        p0, p1 = np.array([r[k], z[k]]), np.array([r[k + 1], z[k + 1]])
+        if seg.arc_center is None:
+            pts = p0[None] + u[:, None] * (p1 - p0)[None]
+        else:
+            c = np.asarray(seg.arc_center, float)
+            rho0, rho1 = np.linalg.norm(p0 - c), np.linalg.norm(p1 - c)
+            if abs(rho0 - rho1) > 1e-6 * max(rho0, rho1) or rho0 == 0:
+                raise MeshError(
+                    f"segments[{k}].arc_center {c.tolist()}: the centre must be equally far from both end points "
+                    f"({p0.tolist()} at {rho0:.9g}, {p1.tolist()} at {rho1:.9g}); correct the centre or the points")
+            a0 = np.arctan2(*(p0 - c)[::-1])
+            da = (np.arctan2(*(p1 - c)[::-1]) - a0 + np.pi) % (2 * np.pi) - np.pi
+            if abs(abs(da) - np.pi) < 1e-9:
+                raise MeshError(f"segments[{k}]: the arc is a half circle, its direction is ambiguous; split it "
+                                "with a meridian point in between")
+            rho = 0.5 * (rho0 + rho1)
+            a = a0 + u * da
+            pts = c[None] + rho * np.stack([np.cos(a), np.sin(a)], -1)
+        rs.append(pts[:, 0])
+        zs.append(pts[:, 1])
+        if thickness is not None:
+            hs.append(thickness[k] + u * (thickness[k + 1] - thickness[k]))
+    return np.concatenate(rs), np.concatenate(zs), (np.concatenate(hs) if thickness is not None else None)
+
+
+def revolution(meridian_r, meridian_z, n_meridian: int | None, n_circ: int, angle: float = 360.0,
+               normal: str = "inward", segments: list[MeridianSegment] | None = None,
+               thickness=None) -> Mesh:
+    """Shell of revolution about the z axis from a meridian through the points (r_k, z_k).
+
+    Either ``n_meridian`` elements of equal length along the polyline (resampled by arc length),
+    or ``segments``: one :class:`MeridianSegment` per pair of consecutive points, each straight or
+    a circular arc, with its own number of elements and an element-set name (segments may share a
+    name). ``n_circ`` elements around the axis over ``angle`` degrees. ``normal`` 'inward' or
+    'outward' relative to the axis (a dome with the reference surface on the inner face:
+    'outward'). The first element coordinate line is the hoop direction, so a layer without
+    ``direction`` has material axis 1 along the hoop.
+
+    ``thickness``: optional value per meridian point, interpolated linearly along the meridian
+    (per segment) and stored as ``node_fields['h_meridian']``.
+
+    Node sets: 'first'/'last' (the circles at the first and last meridian point), 'start'/'end'
+    (the meridians at angle 0 and ``angle``; merged when closed) and, with segments,
+    'meridian_point_k' (the circle through meridian point k).
     """
     r = np.asarray(meridian_r, float)
     z = np.asarray(meridian_z, float)
-    if r.shape != z.shape or r.size < 2:
+    if r.shape != z.shape or r.ndim != 1 or r.size < 2:
         raise MeshError("meridian: r and z need the same length >= 2")
-    sl = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(r), np.diff(z)))])
+    h = None if thickness is None else np.asarray(thickness, float)
+    if h is not None and h.shape != r.shape:
+        raise MeshError(f"meridian_thickness: give one value per meridian point ({r.size}), got {h.size}")
+    if segments is None:
+        if n_meridian is None or n_meridian < 1:
+            raise MeshError("give n_meridian (elements along the meridian) or segments")
+        sl = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(r), np.diff(z)))])
+        at = np.linspace(0.0, sl[-1], 2 * n_meridian + 1)
+        mr, mz = np.interp(at, sl, r), np.interp(at, sl, z)
+        mh = np.interp(at, sl, h) if h is not None else None
+        rows = np.full(n_meridian, -1)
+    else:
+        if len(segments) != r.size - 1:
+            raise MeshError(f"segments: give one segment per pair of consecutive meridian points ({r.size - 1}), "
+                            f"got {len(segments)}")
+        mr, mz, mh = _meridian_nodes(r, z, list(segments), h)
+        n_meridian = sum(sg.elements for sg in segments)
+        rows = np.repeat(np.arange(len(segments)), [sg.elements for sg in segments])
     closed = abs(angle - 360.0) < 1e-9
+    n_row = 2 * n_meridian
 
     def fn(s, t):
-        rr = np.interp(t * sl[-1], sl, r)
-        zz = np.interp(t * sl[-1], sl, z)
+        j = np.rint(t * n_row).astype(np.int64)
         ph = np.deg2rad(angle) * s
-        return np.stack([rr * np.cos(ph), rr * np.sin(ph), zz], -1)
+        return np.stack([mr[j] * np.cos(ph), mr[j] * np.sin(ph), mz[j]], -1)
 
     mesh = _structured(n_circ, n_meridian, fn, ("start", "end", "first", "last"))
+    n_s = 2 * n_circ + 1
+    grid_row = np.arange(mesh.n_nodes) // n_s  # meridian node index of every grid node
+    if mh is not None:
+        mesh.node_fields["h_meridian"] = mh[grid_row]
+    if segments is not None:
+        ends = 2 * np.concatenate([[0], np.cumsum([sg.elements for sg in segments])])
+        for k, j in enumerate(ends):
+            mesh.node_sets[f"meridian_point_{k}"] = j * n_s + np.arange(n_s)
+        el_row = np.arange(mesh.n_elements) // n_circ  # elements are numbered row by row
+        for k, sg in enumerate(segments):
+            if sg.name:
+                sel = np.flatnonzero(rows[el_row] == k)
+                prev = mesh.element_sets.get(sg.name, np.zeros(0, np.int64))
+                mesh.element_sets[sg.name] = np.union1d(prev, sel)
     if closed:
         mesh = merge_coincident(mesh)
     sign = -1.0 if normal == "inward" else 1.0
@@ -188,4 +373,5 @@ def merge_coincident(mesh: Mesh, tol: float | None = None) -> Mesh:
     nodes = mesh.nodes[first[order]]
     elements = remap[inv.ravel()][mesh.elements]
     sets = {k: np.unique(remap[inv.ravel()][v]) for k, v in mesh.node_sets.items()}
-    return Mesh(nodes, elements, sets, dict(mesh.element_sets), list(mesh.notes))
+    fields = {k: np.asarray(v)[first[order]] for k, v in mesh.node_fields.items()}
+    return Mesh(nodes, elements, sets, dict(mesh.element_sets), list(mesh.notes), fields)

@@ -1,4 +1,4 @@
-"""Quick-look PNG plots (matplotlib, Agg backend).
+"""PNG figures (matplotlib, Agg backend); :func:`write_figures` writes all figures of a run.
 
 matplotlib is imported inside the functions so that the core package does not need it at
 import time. Figures are built on an Agg canvas directly (no pyplot, so the global backend of
@@ -86,10 +86,14 @@ def _outlines(grid: np.ndarray) -> np.ndarray:
 
 
 def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str = "magnitude",
-                  scale: float | None = None) -> Path:
+                  scale: float | None = None, info: bool = False):
     """3D view of the reference surface: undeformed grey wireframe, deformed surface coloured by
     ``field`` ('magnitude' = |u|, or 'x', 'y', 'z' for a component) of the reference-face
-    displacement. ``scale=None``: the largest displacement is drawn as 10 % of the model size."""
+    displacement. ``scale=None``: the largest displacement is drawn as 10 % of the model size.
+
+    The colour scale spans the field over the sampled surface (5×5 points per element, nodes
+    included). Returns the path, or with ``info`` ``(path, {"field", "scale", "max_u",
+    "color_range"})``."""
     from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
     from .export import reference_displacement
@@ -122,8 +126,10 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     ax.add_collection3d(Line3DCollection(_outlines(X), colors="0.6", linewidths=0.6))
     poly = Poly3DCollection(quads, cmap="viridis", edgecolors="none", linewidths=0.0)
     poly.set_array(qv)
-    if qv.size:
-        lo, hi = float(qv.min()), float(qv.max())
+    clim = (0.0, 0.0)
+    if V.size:
+        lo, hi = float(V.min()), float(V.max())
+        clim = (lo, hi)
         poly.set_clim(lo, hi if hi > lo else lo + 1e-30)
     ax.add_collection3d(poly)
     ax.add_collection3d(Line3DCollection(_outlines(x_def), colors="k", linewidths=0.4))
@@ -140,15 +146,24 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     ax.set_zlabel("z")
     ax.set_title(f"deformed (scale {scale:.3g}), max |u| = {umax:.4g}")
     fig.colorbar(poly, ax=ax, shrink=0.7, label=label)
-    return _save(fig, path)
+    path = _save(fig, path)
+    if info:
+        return path, {"field": label, "scale": float(scale), "max_u": umax, "color_range": clim}
+    return path
 
 
-def plot_through_thickness(path, columns: dict[str, tuple[np.ndarray, np.ndarray]], xlabel: str) -> Path:
-    """Stress (x) versus Θ³ (y) along thickness columns: ``columns[name] = (stress, theta3)``."""
+def plot_through_thickness(path, columns: dict[str, tuple[np.ndarray, np.ndarray]], xlabel: str,
+                           mark: tuple[float, float] | None = None, title: str = "") -> Path:
+    """Stress (x) versus Θ³ (y) along thickness columns: ``columns[name] = (stress, theta3)``;
+    ``mark = (stress, Θ³)`` draws one point (e.g. a probe's value) on top."""
     fig = _figure((5, 6))
     ax = fig.subplots()
     for name, (s, t) in columns.items():
         ax.plot(np.asarray(s, float), np.asarray(t, float), ".-", lw=1.2, ms=4, label=name)
+    if mark is not None:
+        ax.plot([mark[0]], [mark[1]], "kx", ms=9, mew=2, label="probe")
+    if title:
+        ax.set_title(title)
     ax.axvline(0.0, color="0.5", lw=0.6)
     ax.set_xlabel(xlabel)
     ax.set_ylabel("Θ³")
@@ -156,32 +171,6 @@ def plot_through_thickness(path, columns: dict[str, tuple[np.ndarray, np.ndarray
     if columns:
         ax.legend(fontsize="small")
     fig.tight_layout()
-    return _save(fig, path)
-
-
-def plot_debonded_zone(path, controller, title: str = "") -> Path:
-    """Plan view of every interface: face Gauss points (the "integration points of layer L")
-    bonded (grey) or debonded (red), sized by their area; one panel per interface."""
-    runs = controller.runs
-    fig = _figure((5.0 * max(len(runs), 1), 4.6))
-    for i, r in enumerate(runs):
-        ax = fig.add_subplot(1, max(len(runs), 1), i + 1)
-        from .element.geometry import surface_points
-        from .element.quadrature import gauss_2d
-
-        pts, _ = gauss_2d(3)
-        blk = r.block
-        X = surface_points(controller.mesh_nodes[blk.conn], pts[:, 0], pts[:, 1]).X0
-        rel = blk.released.ravel()
-        w = blk.w0.ravel()
-        s = 400.0 * w / w.max()
-        ax.scatter(X[..., 0].ravel()[~rel], X[..., 1].ravel()[~rel], s=s[~rel], c="0.75", label="bonded")
-        ax.scatter(X[..., 0].ravel()[rel], X[..., 1].ravel()[rel], s=s[rel], c="tab:red", label="debonded")
-        ax.set_aspect("equal")
-        ax.set_xlabel("x")
-        ax.set_ylabel("y")
-        ax.set_title(f"{blk.itf.name} {title}".strip())
-        ax.legend(loc="upper right", fontsize=8)
     return _save(fig, path)
 
 
@@ -196,3 +185,151 @@ def plot_load_vs_area(path, load_factors, areas: dict[str, list[float]], units: 
     ax.grid(True, alpha=0.3)
     ax.legend()
     return _save(fig, path)
+
+
+# ----------------------------------------------------------------------------- a run's figures
+
+
+class ZoneHistory:
+    """Debonded flags of every interface after each converged step, for zone maps at chosen steps.
+
+    Create it with the run's interface controller (or None: then it records nothing) and call
+    :meth:`record` once per converged step. Memory: one bool per face Gauss point and step.
+    """
+
+    def __init__(self, controller=None):
+        self.controller = controller
+        self.initial = [r.block.released.copy() for r in controller.runs] if controller is not None else []
+        self.steps: list[int] = []
+        self.load_factors: list[float] = []
+        self.released: list[list[np.ndarray]] = []
+
+    def record(self, step: int, load_factor: float) -> None:
+        if self.controller is None:
+            return
+        self.steps.append(int(step))
+        self.load_factors.append(float(load_factor))
+        self.released.append([r.block.released.copy() for r in self.controller.runs])
+
+    def default_steps(self) -> list[int]:
+        """The first step with newly debonded points (beyond the initially debonded zones) and the
+        last recorded step."""
+        if not self.steps:
+            return []
+        first = next((s for s, rel in zip(self.steps, self.released)
+                      if any(np.any(a & ~b) for a, b in zip(rel, self.initial))), None)
+        return sorted({s for s in (first, self.steps[-1]) if s is not None})
+
+
+def plot_zone_maps(path, controller, itf_index: int, maps: list[tuple[str, np.ndarray]]) -> Path:
+    """Plan view of one interface at several states: face Gauss points bonded (grey) or debonded
+    (red), sized by their area; one panel per ``(title, released (e, q))`` in ``maps``."""
+    from .element.geometry import surface_points
+    from .element.quadrature import gauss_2d
+
+    blk = controller.runs[itf_index].block
+    pts, _ = gauss_2d(3)
+    X = surface_points(controller.mesh_nodes[blk.conn], pts[:, 0], pts[:, 1]).X0
+    x, y = X[..., 0].ravel(), X[..., 1].ravel()
+    w = blk.w0.ravel()
+    s = 400.0 * w / w.max() * min(1.0, 50.0 / max(len(blk.conn), 1)) ** 0.5
+    from matplotlib.collections import LineCollection
+    from matplotlib.lines import Line2D
+
+    corners = controller.mesh_nodes[blk.conn][:, [0, 4, 1, 5, 2, 6, 3, 7, 0], :2]  # element outlines
+    n = max(len(maps), 1)
+    fig = _figure((4.6 * n, 4.8))
+    for i, (title, released) in enumerate(maps):
+        ax = fig.add_subplot(1, n, i + 1)
+        ax.add_collection(LineCollection(corners, colors="0.55", linewidths=0.6))
+        rel = np.asarray(released, bool).ravel()
+        ax.scatter(x[~rel], y[~rel], s=s[~rel], c="0.75")
+        ax.scatter(x[rel], y[rel], s=s[rel], c="tab:red")
+        ax.set_aspect("equal")
+        ax.margins(0.05)
+        ax.set_xlabel("x")
+        ax.set_ylabel("y")
+        area = float((blk.w0 * np.asarray(released, bool)).sum())
+        ax.set_title(f"{blk.itf.name}: {title}\ndebonded area {area:.4g}", fontsize=10)
+        handles = [Line2D([], [], ls="", marker="o", ms=7, color=c, label=f"{lab} ({k} points)")
+                   for c, lab, k in (("0.75", "bonded", int((~rel).sum())), ("tab:red", "debonded", int(rel.sum())))]
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8,
+                  frameon=False)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _safe(name: str) -> str:
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in name)
+
+
+def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneHistory | None = None) -> dict:
+    """All PNG figures of a run, written into ``out`` (called once after the last step).
+
+    - ``load_displacement.png`` (every probe) and ``load_displacement_<probe>.png`` (one each):
+      load factor against the probe value per converged step;
+    - ``deformed.png``: the deformed reference surface coloured by |u| (last converged step);
+    - ``thickness_<probe>.png``: for every stress probe at a ``point``, its component through
+      all layers at that point (last converged step), the probe's own Θ³ marked;
+    - with delamination: ``debonded_zone_<interface>.png`` (one panel per step of
+      ``[output] zone_steps``, default: first debonding and last step) and
+      ``load_debonded_area.png``.
+
+    Returns ``{file name: info}`` (info: a dict of the plotted data ranges, for checks).
+    """
+    out = Path(out)
+    model = spec.model
+    steps = summary.get("steps", [])
+    files: dict[str, dict] = {}
+    if not steps:
+        return files
+    lam = [s["load_factor"] for s in steps]
+    names = [p.name for p in spec.probes]
+    if names:
+        series = {n: [s["probes"][n] for s in steps] for n in names}
+        plot_load_displacement(out / "load_displacement.png", lam, series, model.units)
+        files["load_displacement.png"] = {"probes": names}
+        for n in names:
+            f = f"load_displacement_{_safe(n)}.png"
+            plot_load_displacement(out / f, lam, {n: series[n]}, model.units)
+            files[f] = {"probe": n, "range": (float(min(series[n])), float(max(series[n])))}
+
+    files["deformed.png"] = plot_deformed(out / "deformed.png", model, problem.dm, u, info=True)[1]
+
+    for pd in spec.source.probes:
+        if pd.quantity != "stress" or pd.point is None:
+            continue
+        from types import SimpleNamespace
+
+        from .runner import through_thickness
+
+        prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21)
+        cols = through_thickness(prof, model, problem.dm, u)
+        f = f"thickness_{_safe(pd.name)}.png"
+        mark = None
+        if isinstance(pd.theta3, (int, float)) and pd.reduce == "none" and pd.scale:
+            mark = (float(summary["probes"][pd.name]) / pd.scale, float(pd.theta3))
+        plot_through_thickness(out / f, {k: (v, t) for k, (t, v) in cols.items()},
+                               f"{pd.measure} σ{pd.component} at {tuple(pd.point)} (λ = {lam[-1]:.4g})", mark=mark,
+                               title=f"probe {pd.name}")
+        vals = np.concatenate([v for _, v in cols.values()])
+        files[f] = {"probe": pd.name, "range": (float(vals.min()), float(vals.max()))}
+
+    ctl = problem.interfaces
+    if ctl is not None and zones is not None and zones.steps:
+        wanted = spec.output.zone_steps if spec.output.zone_steps else zones.default_steps()
+        chosen = [s for s in wanted if s in zones.steps]
+        for i, r in enumerate(ctl.runs):
+            maps = [(f"step {s}, λ = {zones.load_factors[zones.steps.index(s)]:.4g}",
+                     zones.released[zones.steps.index(s)][i]) for s in chosen]
+            if not maps:
+                continue
+            f = f"debonded_zone_{_safe(r.block.itf.name)}.png"
+            plot_zone_maps(out / f, ctl, i, maps)
+            files[f] = {"steps": chosen}
+    da = summary.get("debonded_area") or []
+    if da:
+        plot_load_vs_area(out / "load_debonded_area.png", [a["load_factor"] for a in da],
+                          {k: [a[k] for a in da] for k in da[0] if k not in ("step", "load_factor")})
+        files["load_debonded_area.png"] = {}
+    return files

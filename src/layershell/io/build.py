@@ -4,8 +4,10 @@ Every error is an :class:`InputError` with one paragraph naming the field and th
 """
 from __future__ import annotations
 
+import contextlib
 import difflib
 import importlib.util
+import io
 import math
 import re
 import tomllib
@@ -225,7 +227,8 @@ def load(path: str | Path) -> RunSpec:
         raise InputError(f"model file '{path}' cannot be read: {exc.strerror or exc}") from None
     mf = parse(text, str(path))
     try:
-        spec = build(mf, path.parent)
+        with np.errstate(all="ignore"):  # huge/odd values are checked explicitly, without numpy's warnings
+            spec = build(mf, path.parent)
     except InputError as exc:
         raise InputError(f"{path}: {exc}") from None
     spec.path = path
@@ -258,7 +261,12 @@ def _node_selection(m: meshmod.Mesh, sel, field: str, required: bool = True) -> 
     lo, hi = x.min(0), x.max(0)
     span = ", ".join(f"{c} ∈ [{a:.6g}, {b:.6g}]" for c, a, b in zip(XYZ, lo, hi))
     if point is not None:
-        d = np.linalg.norm(x - np.asarray(point), axis=1)
+        diff = x - np.asarray(point, float)
+        big = float(np.abs(diff).max(initial=0.0))
+        if not np.isfinite(big):
+            raise InputError(f"'{field}.point': {list(point)} is not a point of finite coordinates; give [x, y, z] "
+                             f"near the mesh, which spans {span}")
+        d = np.linalg.norm(diff / big, axis=1) if big > 0 else np.zeros(len(x))  # scaled: no overflow
         return np.array([int(np.argmin(d))])
     if set_ is not None:
         if set_ not in m.node_sets:
@@ -310,14 +318,39 @@ def boundary_edges(m: meshmod.Mesh) -> np.ndarray:
     return np.array([t for t in tri if t[1] in single], dtype=np.int64).reshape(-1, 3)
 
 
+#: largest generated mesh: more elements do not fit the memory of a workstation anyway
+MAX_ELEMENTS = 2_000_000
+
+
+def _mesh_size(md) -> tuple[int, str] | None:
+    """Elements of a generated mesh before it is built (None for mesh files)."""
+    if md.type == "rectangle":
+        return md.nx * md.ny, "nx × ny"
+    if md.type == "cylinder":
+        return md.n_arc * md.n_width, "n_arc × n_width"
+    if md.type == "revolution":
+        segs = getattr(md, "segments", None)
+        n_mer = md.n_meridian if md.n_meridian is not None else sum(s.elements for s in (segs or []))
+        return n_mer * md.n_circ, "(elements along the meridian) × n_circ"
+    return None
+
+
 def _mesh(md, base: Path) -> meshmod.Mesh:
+    size = _mesh_size(md)
+    if size is not None and size[0] > MAX_ELEMENTS:
+        raise InputError(f"'mesh': {size[1]} = {size[0]} elements is more than layershell can handle (at most "
+                         f"{MAX_ELEMENTS}); use fewer elements")
     if md.type == "rectangle":
         return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal)
     if md.type == "cylinder":
         return meshmod.cylinder(md.radius, md.angle_start, md.angle_end, md.width, md.n_arc, md.n_width,
                                 md.normal, md.axis)
     if md.type == "revolution":
-        return meshmod.revolution(md.meridian_r, md.meridian_z, md.n_meridian, md.n_circ, md.angle, md.normal)
+        segs = None if md.segments is None else [
+            meshmod.MeridianSegment(sg.elements, sg.set, None if sg.arc_center is None else tuple(sg.arc_center))
+            for sg in md.segments]
+        return meshmod.revolution(md.meridian_r, md.meridian_z, md.n_meridian, md.n_circ, md.angle, md.normal,
+                                  segments=segs, thickness=md.meridian_thickness)
     path = base / md.path
     if not path.is_file():
         raise InputError(f"'mesh.path': the mesh file '{md.path}' does not exist (looked for {path}); "
@@ -327,13 +360,16 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
     except ImportError as exc:
         raise InputError(f"'mesh.type': mesh files cannot be read in this installation ({exc}); "
                          "use a 'rectangle', 'cylinder' or 'revolution' mesh") from None
+    said = io.StringIO()  # meshio prints its read errors (and may call sys.exit): keep them for the message
     try:
-        return read_mesh(path, md.scale)
+        with contextlib.redirect_stdout(said), contextlib.redirect_stderr(said):
+            return read_mesh(path, md.scale)
     except (InputError, meshmod.MeshError):
         raise
-    except Exception as exc:  # meshio's ReadError, KeyError, ... on a broken or unsupported file
-        raise InputError(f"'mesh.path': cannot read '{md.path}' ({type(exc).__name__}: {exc}); give a mesh "
-                         "file of 9-node quadrilaterals that meshio can read (Gmsh .msh, .vtu, ...)") from None
+    except (Exception, SystemExit) as exc:  # meshio's ReadError, KeyError, sys.exit, ... on a broken file
+        detail = " ".join(said.getvalue().split()) or f"{type(exc).__name__}: {exc}"
+        raise InputError(f"'mesh.path': cannot read '{md.path}' ({detail}); give a mesh file of 9-node "
+                         "quadrilaterals that meshio can read (Gmsh .msh, .vtu, ...)") from None
 
 
 def _material(name: str, md) -> Orthotropic:
@@ -375,12 +411,17 @@ def _require_finite(vals: np.ndarray, value, field: str, where: str) -> None:
 
 
 def _vec(v, field: str) -> np.ndarray:
+    """Unit vector along ``v`` (scaled by its largest component first: no overflow for huge entries)."""
     a = np.asarray(v, float)
-    n = np.linalg.norm(a)
-    if not (n > 0 and np.isfinite(n)):
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"'{field}': the direction vector must be finite (got {list(v)}); give a non-zero "
+                         "vector [x, y, z] of finite numbers")
+    big = np.abs(a).max(initial=0.0)
+    if not big > 0:
         raise InputError(f"'{field}': the direction vector must not be zero (got {list(v)}); give a non-zero "
                          "vector [x, y, z]")
-    return a / n
+    a = a / big
+    return a / np.linalg.norm(a)
 
 
 # ------------------------------------------------------------------ build
@@ -466,7 +507,8 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             if zone_law is not None:
                 model.initial_laws[k] = zone_law
     d = mf.delamination
-    model.delamination = DelaminationSettings(d.max_release, d.max_resolves, d.friction)
+    model.delamination = DelaminationSettings(d.max_release, d.max_resolves, d.friction,
+                                             d.max_debond_fraction, d.max_debond_cuts)
 
 
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
@@ -487,13 +529,19 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     index = {n: i for i, n in enumerate(names)}
     layers = []
     for i, ld in enumerate(mf.layers):
-        th = _nodal_values(m, ld.thickness, f"layers[{i}].thickness")
+        th = _nodal_values(m, ld.thickness, f"layers[{i}].thickness", **m.node_fields)  # h_meridian: revolution
         if not np.all((th > 0) & np.isfinite(th)):
-            bad = np.flatnonzero(~(th > 0))
-            raise InputError(f"'layers[{i}].thickness': must be positive at every node, but is {th[bad[0]]:.6g} "
-                             f"at node {bad[0]} {m.nodes[bad[0]].round(6).tolist()} ({bad.size} of {m.n_nodes} "
-                             "nodes); give a positive number or a formula in x, y, z that is positive over the "
-                             "whole mesh")
+            bad = np.flatnonzero(~((th > 0) & np.isfinite(th)))
+            raise InputError(f"'layers[{i}].thickness': must be positive and finite at every node, but is "
+                             f"{th[bad[0]]:.6g} at node {bad[0]} {m.nodes[bad[0]].round(6).tolist()} ({bad.size} of "
+                             f"{m.n_nodes} nodes); give a positive number or a formula in x, y, z that is positive "
+                             "over the whole mesh")
+        ratio = th / m.size()
+        if not np.all((ratio >= 1e-10) & (ratio <= 1e10)):
+            j = int(np.argmax(np.abs(np.log10(ratio))))
+            raise InputError(f"'layers[{i}].thickness': {th[j]:.6g} at node {j} is out of scale with the model size "
+                             f"{m.size():.6g} (ratio {ratio[j]:.3g}, allowed 1e-10 to 1e10), so the stiffness cannot be "
+                             "computed in floating point; check the units of the thickness and of the mesh")
         if ld.direction is not None:
             _vec(ld.direction, f"layers[{i}].direction")
         layers.append(Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle,
@@ -628,8 +676,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     else:
         lf = st.lambda_end * np.arange(1, st.n + 1) / st.n
     if st.solver == "pardiso" and importlib.util.find_spec("pypardiso") is None:
-        raise InputError("'steps.solver': 'pardiso' needs the optional package pypardiso (pip install "
-                         "'layershell[fast]'); install it or use solver = 'auto' or 'superlu'")
+        raise InputError("'steps.solver': 'pardiso' needs the package pypardiso (pip install "
+                         "pypardiso; x86-64 only); install it or use solver = 'auto' or 'superlu'")
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
                             max_bisections=st.max_bisections, backend=st.solver)
     _interfaces(mf, model, index, layers)

@@ -14,6 +14,7 @@ import numpy as np
 from ..mesh import Mesh, MeshError, merge_coincident
 
 QUAD_TYPES = ("quad9", "quad8", "quad")
+_NODES = {"quad9": 9, "quad8": 8, "quad": 4}
 
 
 def _to_quad9(kind: str, cells: np.ndarray, points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -64,7 +65,12 @@ def read_mesh(path: str | Path, scale: float = 1.0) -> Mesh:
     elements, owner = [], []
     for i, cb in blocks:
         if cb.type != "quad9":
-            notes.append(f"{len(cb.data)} '{cb.type}' cells converted to 9-node elements")
+            how = ("mid-side and centre nodes on straight lines between the corners" if cb.type == "quad" else
+                   "centre nodes from the 8-node (serendipity) map")
+            notes.append(f"mesh file '{path.name}': {len(cb.data)} {_NODES[cb.type]}-node quadrilaterals "
+                         f"('{cb.type}') converted to 9-node elements ({how}); layershell needs 9-node "
+                         "quadrilaterals, and curved surfaces are represented better by a quad9 mesh "
+                         "(Gmsh: Mesh.ElementOrder = 2, Mesh.SecondOrderIncomplete = 0)")
         points, c9 = _to_quad9(cb.type, np.asarray(cb.data, np.int64), points)
         elements.append(c9)
         owner.append(np.full(len(c9), i))
@@ -77,7 +83,8 @@ def read_mesh(path: str | Path, scale: float = 1.0) -> Mesh:
     for i, cb in blocks:
         offsets[i] = start
         start += len(cb.data)
-    groups = dict(m.cell_sets or {})
+    # meshio's own bookkeeping (e.g. 'gmsh:bounding_entities' of Gmsh 4.1) is not a physical group
+    groups = {k: v for k, v in (m.cell_sets or {}).items() if not k.startswith("gmsh:")}
     phys = (m.cell_data or {}).get("gmsh:physical")
     if phys is not None and m.field_data:  # Gmsh 2.2: physical tags per cell + names in field_data
         for name, (tag, _dim) in ((k, tuple(v[:2])) for k, v in m.field_data.items()):

@@ -9,7 +9,8 @@ from __future__ import annotations
 import math
 from typing import Annotated, Literal, Union, get_args
 
-from pydantic import BaseModel, ConfigDict, Field, PositiveFloat, PositiveInt, field_validator, model_validator
+from pydantic import (BaseModel, ConfigDict, Field, FiniteFloat, PositiveFloat, PositiveInt, field_validator,
+                      model_validator)
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NumOrFormula = Union[float, str]
@@ -37,6 +38,19 @@ class Strict(BaseModel):
                     if bool not in leaves and leaves & {int, float}:
                         data = {**data, k: str(v).lower()}
         return data
+
+    @model_validator(mode="after")
+    def _finite_numbers(self):
+        """Points, vectors, lists of numbers and the hinge height must be finite: NaN or infinity
+        would otherwise pass silently into the geometry."""
+        for name in type(self).model_fields:
+            v = getattr(self, name)
+            values = v if isinstance(v, list) else [v] if name == "height" else []
+            for i, x in enumerate(values):
+                if isinstance(x, float) and not math.isfinite(x):
+                    at = f"{name}[{i}]" if isinstance(v, list) else name
+                    raise ValueError(f"{at} must be a finite number (got {x}); give finite values in '{name}'")
+        return self
 
 
 # ------------------------------------------------------------------ general settings
@@ -80,14 +94,28 @@ class CylinderMesh(Strict):
         return self
 
 
+class MeridianSegment(Strict):
+    elements: PositiveInt = Field(description="elements along this segment")
+    set: str | None = Field(None, description="element set of the segment's elements (segments may share a name)")
+    arc_center: Annotated[list[float], Field(min_length=2, max_length=2)] | None = Field(
+        None, description="[r, z] centre of a circular arc between the segment's end points (the shorter arc); "
+                          "default: straight")
+
+
 class RevolutionMesh(Strict):
     type: Literal["revolution"]
     meridian_r: list[float] = Field(min_length=2)
     meridian_z: list[float] = Field(min_length=2)
-    n_meridian: PositiveInt
+    n_meridian: PositiveInt | None = Field(
+        None, description="elements of equal length along the meridian polyline (or give 'segments')")
     n_circ: PositiveInt
     angle: float = Field(360.0, gt=0, le=360)
     normal: Literal["inward", "outward"] = "outward"
+    segments: list[MeridianSegment] | None = Field(
+        None, description="one per pair of consecutive meridian points: {elements, set, arc_center}")
+    meridian_thickness: list[PositiveFloat] | None = Field(
+        None, description="a value per meridian point, linear along the meridian; layer thickness formulas "
+                          "read it as h_meridian")
 
     @model_validator(mode="after")
     def _same_length(self):
@@ -100,6 +128,15 @@ class RevolutionMesh(Strict):
         if any(a == b for a, b in zip(pts, pts[1:])):
             raise ValueError("consecutive meridian points (meridian_r[i], meridian_z[i]) must differ; remove the "
                              "repeated point")
+        if (self.n_meridian is None) == (self.segments is None):
+            raise ValueError("give either n_meridian (equal elements along the whole meridian) or segments (one "
+                             "{elements = n} per pair of consecutive meridian points), not both or neither")
+        if self.segments is not None and len(self.segments) != len(pts) - 1:
+            raise ValueError(f"segments: give one entry per pair of consecutive meridian points, i.e. "
+                             f"{len(pts) - 1} for {len(pts)} points (got {len(self.segments)})")
+        if self.meridian_thickness is not None and len(self.meridian_thickness) != len(pts):
+            raise ValueError(f"meridian_thickness: give one value per meridian point ({len(pts)}), got "
+                             f"{len(self.meridian_thickness)}")
         return self
 
 
@@ -150,7 +187,7 @@ class LayerDef(Strict):
     material: str
     thickness: NumOrFormula = Field(description="number or formula in x, y, z (evaluated at the nodes)")
     directors: int = Field(3, ge=0, le=4, description="d: u = Σ_{l=0..d} (Θ³)^l u_l")
-    angle: float = Field(0.0, description="material angle ω in degrees about the normal")
+    angle: FiniteFloat = Field(0.0, description="material angle ω in degrees about the normal")
     direction: Vec3 | None = Field(None, description="global direction projected on the surface as material axis 1")
 
     @field_validator("thickness")
@@ -263,11 +300,11 @@ Load = Annotated[Union[SurfaceLoadDef, EdgeLoadDef, VolumeLoadDef, GravityDef, N
 
 # ------------------------------------------------------------------ stepping and probes
 class Steps(Strict):
-    n: PositiveInt = Field(1, description="equal load steps from 0 to lambda_end")
-    lambda_end: float = 1.0
+    n: PositiveInt = Field(1, le=100_000, description="equal load steps from 0 to lambda_end")
+    lambda_end: FiniteFloat = 1.0
     factors: list[float] | None = Field(None, description="explicit load factors (instead of n/lambda_end)")
     tolerance: PositiveFloat = 1e-8
-    max_iterations: PositiveInt = 25
+    max_iterations: PositiveInt = Field(25, le=10_000)
     max_bisections: int = Field(8, ge=0, le=30)
     solver: Literal["auto", "superlu", "pardiso"] = "auto"
 
@@ -284,7 +321,20 @@ class ProbeDef(Strict):
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
     layer: str | None = None
     reduce: Literal["max", "min", "absmax", "mean", "none"] = "none"
-    scale: float = 1.0
+    scale: FiniteFloat = 1.0
+
+    @field_validator("theta3")
+    @classmethod
+    def _theta3(cls, v):
+        if isinstance(v, list):
+            a, b, n = v
+            if not (math.isfinite(a) and math.isfinite(b)):
+                raise ValueError(f"[start, end, n]: start and end must be finite numbers (got {v})")
+            if not (math.isfinite(n) and n == int(n) and 1 <= n <= 100_000):
+                raise ValueError(f"[start, end, n]: n must be a whole number of samples from 1 to 100000 (got {n})")
+        elif not math.isfinite(v):
+            raise ValueError(f"must be a finite number (got {v}); give Θ³ from the reference face")
+        return v
 
 
 class ProfileDef(Strict):
@@ -330,12 +380,28 @@ class DelaminationDef(Strict):
         "return_mapping", description="friction as a regularised return mapping, or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
     max_resolves: PositiveInt = 100
+    max_debond_fraction: float | None = Field(
+        None, gt=0, le=1,
+        description="step cutting: a load increment whose re-solutions debond more than this fraction of the "
+                    "interface area is undone and halved (the delamination state is then updated at every "
+                    "sub-step); off when not given")
+    max_debond_cuts: int = Field(4, ge=0, le=20, description="most halvings per load step for max_debond_fraction")
 
 
 class OutputDef(Strict):
     vtu: bool = True
     plots: bool = True
     every: PositiveInt = Field(1, description="write ParaView files every n-th step (the last is always written)")
+    zone_steps: list[PositiveInt] | None = Field(
+        None, description="load steps (1 = first, as in probes.csv) whose debonded zones are drawn in "
+                          "debonded_zone_<interface>.png; default: the first step with new debonding and the last")
+
+    @field_validator("zone_steps")
+    @classmethod
+    def _distinct(cls, v):
+        if v is not None and len(set(v)) != len(v):
+            raise ValueError(f"steps must not repeat (got {v}); list each load step once")
+        return sorted(v) if v is not None else v
 
 
 class ModelFile(Strict):
@@ -364,6 +430,11 @@ class ModelFile(Strict):
             if ly.material not in self.materials:
                 raise ValueError(f"'layers[{i}].material': unknown material '{ly.material}'; defined: "
                                  f"{sorted(self.materials)} (fix the name or add a [materials.{ly.material}] table)")
+        zs = self.output.zone_steps
+        n_steps = len(self.steps.factors) if self.steps.factors is not None else self.steps.n
+        if zs and max(zs) > n_steps:
+            raise ValueError(f"'output.zone_steps': step {max(zs)} does not exist, the model has {n_steps} load "
+                             f"step(s); give step numbers from 1 to {n_steps}")
         pn = [p.name for p in self.probes]
         dup = {n for n in pn if pn.count(n) > 1}
         if dup:

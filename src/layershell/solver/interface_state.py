@@ -20,7 +20,7 @@ In both, σ33 is the contact pressure and there is no friction where the gap is 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
@@ -50,6 +50,10 @@ class DelaminationSettings:
     max_release: int | None = None  # nodes released per re-solution (largest V first)
     max_resolves: int = 100
     friction: str = "return_mapping"  # or "explicit"
+    # step cutting: a (sub)step whose re-solutions debond more than this fraction of the interface
+    # area is undone and its load increment halved (at most ``max_debond_cuts`` times per step)
+    max_debond_fraction: float | None = None
+    max_debond_cuts: int = 4
 
 
 @dataclass
@@ -186,7 +190,11 @@ class InterfaceController:
             r.tau = np.where(new[..., None], tau_rm, r.tau)
             r.fresh = new
             if blk.alpha_T is not None:  # anchor so that the point transmits the mapped shear (×0.999)
-                gTu = np.einsum("eqij,eqj->eqi", blk.projector(), du)
+                P = blk.projector()
+                gTu = np.einsum("eqij,eqj->eqi", P, du)
+                # the friction law acts in the undeformed tangent plane (P); the mapped shear is
+                # expressed in the current basis m_α, so project it (keeps the tangent symmetric)
+                tau_rm = np.einsum("eqij,eqj->eqi", P, tau_rm)
                 x0 = (1.0 / (1.0 - 0.999 ** FRICTION_SHARPNESS) - 1.0) ** (-1.0 / FRICTION_SHARPNESS)  # f(x0) = 0.999
                 blk.t_n = np.where(new[..., None], 0.999 * tau_rm, blk.t_n)
                 blk.g_p = np.where(new[..., None], gTu - x0 * tau_rm / blk.alpha_T, blk.g_p)
@@ -201,10 +209,98 @@ class InterfaceController:
                                "the debonding does not stabilise (unstable delamination)")
         return new_any
 
+    # ------------------------------------------------------------------ restart
+    #: the friction state of a contact block (the history of an :class:`InterfaceRun` is every
+    #: array field of it: initial, gmax, tau, fresh, V, gap, slip, pressure)
+    BLOCK_ARRAYS = ("cap", "t_n", "g_p")
+
+    @staticmethod
+    def _run_arrays(r: InterfaceRun) -> list[str]:
+        return [f.name for f in fields(r) if isinstance(getattr(r, f.name), np.ndarray)]
+
+    def state(self, problem) -> dict[str, np.ndarray]:
+        """Copies of everything that the next load steps depend on, as flat named arrays (for
+        :mod:`layershell.checkpoint`): the nodal bond flags of every interface, and per interface
+        the history (g_T^max, slip, gap, pressure, friction loads, failure function, freshly
+        released points, first failure) and the return-mapping state (slip limit, committed
+        traction, slip anchor). The released points and the friction load vector follow from
+        these (:meth:`sync`)."""
+        out: dict[str, np.ndarray] = {f"bonded.{k}": np.array(v, copy=True) for k, v in problem.bonded.items()}
+        out["lam"] = np.array(self.lam, float)
+        for i, r in enumerate(self.runs):
+            for name in self._run_arrays(r):
+                out[f"run{i}.{name}"] = np.array(getattr(r, name), copy=True)
+            out[f"run{i}.first_failure"] = np.array(np.nan if r.first_failure is None else r.first_failure, float)
+            for name in self.BLOCK_ARRAYS:
+                value = getattr(r.block, name)
+                if value is not None:
+                    out[f"run{i}.block.{name}"] = np.array(value, copy=True)
+        return out
+
+    def restore(self, problem, state: dict[str, np.ndarray]) -> None:
+        """Inverse of :meth:`state` on a freshly built problem of the same model: sets the bond
+        flags (and rebuilds the constraint operator), the histories and the friction state.
+        Raises ValueError naming the entry when ``state`` does not fit this model."""
+        def take(key: str, like: np.ndarray | None) -> np.ndarray:
+            if key not in state:
+                raise ValueError(f"the saved interface state has no '{key}'")
+            value = np.asarray(state[key])
+            if like is not None and (value.shape != np.shape(like) or value.dtype.kind != np.asarray(like).dtype.kind):
+                raise ValueError(f"the saved interface state '{key}' has shape {value.shape} ({value.dtype}), "
+                                 f"this model needs {np.shape(like)} ({np.asarray(like).dtype})")
+            return value.copy()
+
+        saved_bonds = sorted(k for k in state if k.startswith("bonded."))
+        if saved_bonds != sorted(f"bonded.{k}" for k in problem.bonded):
+            raise ValueError(f"the saved bond flags are for the interfaces {saved_bonds}, this model has "
+                             f"{sorted(f'bonded.{k}' for k in problem.bonded)}")
+        runs = {k.split(".")[0] for k in state if k.startswith("run")}
+        if len(runs) != len(self.runs):
+            raise ValueError(f"the saved state has {len(runs)} interface(s) with a law, this model {len(self.runs)}")
+        for k in problem.bonded:
+            problem.bonded[k] = take(f"bonded.{k}", problem.bonded[k])
+        self.lam = float(take("lam", None))
+        for i, r in enumerate(self.runs):
+            for name in self._run_arrays(r):
+                setattr(r, name, take(f"run{i}.{name}", getattr(r, name)))
+            ff = float(take(f"run{i}.first_failure", None))
+            r.first_failure = None if np.isnan(ff) else ff
+            for name in self.BLOCK_ARRAYS:
+                if getattr(r.block, name) is not None:
+                    setattr(r.block, name, take(f"run{i}.block.{name}", getattr(r.block, name)))
+            r.block.active = None
+        self.resolves = 0
+        problem.rebuild_constraints()
+        self.sync(problem)
+
     # ------------------------------------------------------------------ results
     def first_failure(self) -> float | None:
         vals = [r.first_failure for r in self.runs if r.first_failure is not None]
         return min(vals) if vals else None
+
+    def debonded_extent(self, nodes: np.ndarray) -> dict[str, dict[str, float]]:
+        """Per interface: released area and the bounding box (x, y) of the released interface
+        points in the reference configuration (``nodes``: mesh coordinates), None where none."""
+        from ..element.geometry import surface_points
+        from ..element.quadrature import gauss_2d
+
+        out = {}
+        for r in self.runs:
+            blk = r.block
+            if not hasattr(blk, "_points"):
+                xi, eta = gauss_2d(int(round(np.sqrt(blk.w.shape[1]))))[0].T
+                blk._points = surface_points(nodes[blk.conn], xi, eta).X0
+            P = blk._points[blk.released]
+            box = {f"{c}_{m}": (float(getattr(P[:, i], m)()) if P.size else None)
+                   for i, c in enumerate("xy") for m in ("min", "max")}
+            out[blk.itf.name] = {"area": float((blk.w0 * blk.released).sum()), **box}
+        return out
+
+    def debonded_fraction(self) -> float:
+        """Released share of all interface area (for step cutting)."""
+        a = sum(float((r.block.w0 * r.block.released).sum()) for r in self.runs)
+        A = sum(float(r.block.w0.sum()) for r in self.runs)
+        return a / A if A > 0 else 0.0
 
     def debonded_area(self) -> dict[str, float]:
         return {r.block.itf.name: float((r.block.w0 * r.block.released).sum()) for r in self.runs}

@@ -1,0 +1,187 @@
+"""Thesis §5.2 pull-off test (MODEL.md V6): examples/pulloff.toml.
+
+Runs the example once (module fixture), writes results/pulloff/ (summary.json, probes.csv,
+debonded_zone_*.png, delamination.csv, ...) and the force - debonded-length table
+results/pulloff/force_debonded_length.csv, then checks convergence, the onset load, the
+monotonic growth of the debonded zone and where debonding starts (the 4/5 element edge).
+
+The table can also be made from any summary.json of the example:
+``force_debonded_length_rows(json.load(open("summary.json")))``.
+"""
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from layershell.element.geometry import surface_points
+from layershell.element.quadrature import gauss_2d
+from layershell.io.build import load
+from layershell.runner import run
+from layershell.solver.problem import Problem
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLE = ROOT / "examples" / "pulloff.toml"
+OUT = ROOT / "results" / "pulloff"
+
+# geometry of examples/pulloff.toml (assumptions documented there)
+F_FULL_KN = 30.0  # F = λ × 30 kN on the full strap
+HALF_WIDTH = 50.0  # strap width on the half model (mm)
+X_EDGE45 = 120.0  # the 4/5 element edge: end of the unbonded zone (mm)
+ELEMENT_LENGTH = 30.0  # element length along the load (mm)
+BOND_END = 270.0  # end of the bond zone (mm)
+INTERFACE = "prism/strap"
+# thesis §5.2: first debonding between 10.7 and 15.9 kN
+ONSET_BAND = (10.7 / F_FULL_KN, 15.9 / F_FULL_KN)
+
+
+def force_debonded_length_rows(summary: dict, interface: str = INTERFACE) -> list[dict]:
+    """One row per converged step: load factor, pull force F (kN, full specimen), debonded area
+    of the half model (mm², released interface regions, initially unbonded zone included),
+    mean debonded length = area / half strap width (mm), and the front: the largest x of the
+    released interface points (mm; the bond zone starts at x = 120)."""
+    rows = []
+    for st in summary["steps"]:
+        ext = st["debonded_extent"][interface]
+        rows.append({"load_factor": st["load_factor"], "force_kN": st["load_factor"] * F_FULL_KN,
+                     "debonded_area_mm2": ext["area"], "debonded_length_mm": ext["area"] / HALF_WIDTH,
+                     "front_x_mm": ext["x_max"]})
+    return rows
+
+
+def write_force_debonded_length(summary: dict, path: Path) -> list[dict]:
+    rows = force_debonded_length_rows(summary)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["load_factor", "force_kN", "debonded_area_mm2", "debonded_length_mm", "front_x_mm"])
+        for r in rows:
+            w.writerow([f"{r['load_factor']:.4g}", f"{r['force_kN']:.4g}", f"{r['debonded_area_mm2']:.6g}",
+                        f"{r['debonded_length_mm']:.5g}", f"{r['front_x_mm']:.5g}"])
+    return rows
+
+
+def _interface_points(problem) -> tuple[np.ndarray, object]:
+    blk = problem.interfaces.runs[0].block
+    xi, eta = gauss_2d(3)[0].T
+    X = surface_points(problem.model.mesh.nodes[blk.conn], xi, eta).X0  # (e, 9, 3)
+    return X, blk
+
+
+@pytest.fixture(scope="module")
+def pulloff():
+    """Run the example once; keep the released interface points of every converged step."""
+    spec = load(EXAMPLE)
+    captured: list = []
+    released: list[np.ndarray] = []
+    original = Problem.build.__func__
+
+    def spy(cls, model):
+        pb = original(cls, model)
+        captured.append(pb)
+        return pb
+
+    def progress(step, n, lam):
+        released.append(captured[-1].interfaces.runs[0].block.released.copy())
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(Problem, "build", classmethod(spy))
+        res = run(spec, OUT, progress=progress, write_vtu=False)
+    rows = write_force_debonded_length(res.summary, OUT / "force_debonded_length.csv")
+    return res, released, rows
+
+
+@pytest.mark.slow
+def test_pulloff_converges(pulloff):
+    res, released, rows = pulloff
+    assert res.converged, res.message
+    assert len(rows) == len(res.summary["steps"]) == len(released)
+    assert (OUT / "force_debonded_length.csv").is_file()
+    # the runner's own table: debonded area and the front (largest x of the released points)
+    table = list(csv.DictReader(open(OUT / "delamination.csv")))
+    assert len(table) == len(rows)
+    for row, r in zip(table, rows):
+        assert float(row[f"{INTERFACE}:area"]) == pytest.approx(r["debonded_area_mm2"], rel=1e-9)
+        assert float(row[f"{INTERFACE}:x_max"]) == pytest.approx(r["front_x_mm"], rel=1e-9)
+    assert json.loads((OUT / "summary.json").read_text())["converged"]
+
+
+def predicted_onset(lam0: float = 0.05) -> float:
+    """Independent estimate of the first debonding: solve the example at the small load factor
+    ``lam0`` (no interface update), take the interface tractions at the bonded points and scale
+    them until the failure function (4.15)-(4.16) reaches zero at the first point (bisection per
+    point). Exact where the response before debonding is linear in λ."""
+    from layershell.delamination import failure_function
+    from layershell.interfaces import interface_state
+    from layershell.solver.newton import load_steps
+
+    spec = load(EXAMPLE)
+    pb = Problem.build(spec.model)
+    st = list(load_steps(pb, np.array([lam0]), spec.newton))[-1]
+    r = pb.interfaces.runs[0]
+    blk = r.block
+    t = interface_state(spec.model, pb.dm, st.u, blk.itf, "gauss").traction().reshape(*blk.w.shape, 3)
+    t = t[~blk.released]
+    lo, hi = np.zeros(len(t)), np.full(len(t), 1e3)
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        failed = failure_function(mid[:, None] * t, r.law)[1]
+        hi, lo = np.where(failed, mid, hi), np.where(failed, lo, mid)
+    return lam0 * float(hi.min())
+
+
+@pytest.mark.slow
+def test_pulloff_onset_load(pulloff):
+    """The run's first debonding is the first load step at or above the independent prediction
+    (the factors are 0.025 apart there; 3 % allowance for the slight nonlinearity)."""
+    res, _, _ = pulloff
+    lam = res.summary["first_delamination_load_factor"]
+    assert lam is not None
+    pred = predicted_onset()
+    factors = [s["load_factor"] for s in res.summary["steps"]]
+    expected = min(f for f in factors if f >= 0.97 * pred)
+    print(f"first debonding at λ = {lam} (F = {lam * F_FULL_KN:.1f} kN); predicted {pred:.4f}; "
+          f"thesis 0.357-0.530")
+    assert lam == expected
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="onset λ = 0.30 (9 kN) with the assumed dimensions, 16 % below the "
+                   "thesis's 10.7-15.9 kN; the specimen's dimensions (thesis Figs. 5.6-5.7) are not available "
+                   "and nothing was tuned")
+def test_pulloff_onset_in_thesis_band(pulloff):
+    res, _, _ = pulloff
+    lam = res.summary["first_delamination_load_factor"]
+    assert ONSET_BAND[0] <= lam <= ONSET_BAND[1]
+
+
+@pytest.mark.slow
+def test_pulloff_debonded_area_grows(pulloff):
+    res, released, rows = pulloff
+    area = np.array([r["debonded_area_mm2"] for r in rows])
+    assert np.all(np.diff(area) >= -1e-9)
+    # initially unbonded zone: elements 1-4 less the regions of the (bonded) 4/5 edge nodes
+    assert area[0] == pytest.approx(HALF_WIDTH * (X_EDGE45 - ELEMENT_LENGTH * (1 - np.sqrt(0.6)) / 2), rel=1e-9)
+    assert area[-1] > area[0]  # the bond zone debonds
+    # release is irreversible, step by step
+    for a, b in zip(released, released[1:]):
+        assert np.all(b[a])
+
+
+@pytest.mark.slow
+def test_pulloff_debonding_starts_at_edge_4_5(pulloff):
+    res, released, _ = pulloff
+    X, blk = _interface_points(res.problem)
+    lam = res.summary["first_delamination_load_factor"]
+    k = [s["load_factor"] for s in res.summary["steps"]].index(lam)
+    before = released[k - 1] if k > 0 else np.zeros_like(released[0])
+    new = released[k] & ~before
+    assert new.any()
+    x = X[..., 0][new]
+    # the newly released points lie in the regions of the 4/5 edge nodes (x = 120): within one
+    # third of an element on either side, i.e. element 4's last and element 5's first Gauss column
+    assert np.all(np.abs(x - X_EDGE45) < ELEMENT_LENGTH / 3 + 1e-9), np.unique(np.round(x, 3))
+    assert np.any(x > X_EDGE45)  # bond-zone points (element 5) are among them
