@@ -135,17 +135,17 @@ def predicted_onset(lam0: float = 0.05) -> float:
 
 @pytest.mark.slow
 def test_pulloff_onset_load(pulloff):
-    """The run's first debonding is the first load step at or above the independent prediction
-    (the factors are 0.025 apart there; 3 % allowance for the slight nonlinearity)."""
+    """The independent prediction lies between the last step without and the first step with
+    debonding (3 % allowance for the slight nonlinearity before debonding)."""
     res, _, _ = pulloff
     lam = res.summary["first_delamination_load_factor"]
     assert lam is not None
     pred = predicted_onset()
     factors = [s["load_factor"] for s in res.summary["steps"]]
-    expected = min(f for f in factors if f >= 0.97 * pred)
+    before = factors[factors.index(lam) - 1]
     print(f"first debonding at λ = {lam} (F = {lam * F_FULL_KN:.1f} kN); predicted {pred:.4f}; "
           f"thesis 0.357-0.530")
-    assert lam == expected
+    assert before < 1.03 * pred and 0.97 * pred <= lam
 
 
 @pytest.mark.slow
@@ -163,9 +163,12 @@ def test_pulloff_debonded_area_grows(pulloff):
     res, released, rows = pulloff
     area = np.array([r["debonded_area_mm2"] for r in rows])
     assert np.all(np.diff(area) >= -1e-9)
-    # initially unbonded zone: elements 1-4 less the regions of the (bonded) 4/5 edge nodes
-    assert area[0] == pytest.approx(HALF_WIDTH * (X_EDGE45 - ELEMENT_LENGTH * (1 - np.sqrt(0.6)) / 2), rel=1e-9)
+    # initially unbonded zone: elements 1-4 less the region of the (bonded) 4/5 edge nodes, i.e.
+    # element 4's last Gauss column (weight 5/18 of the element length)
+    assert area[0] == pytest.approx(HALF_WIDTH * (X_EDGE45 - ELEMENT_LENGTH * 5 / 18), rel=1e-9)
     assert area[-1] > area[0]  # the bond zone debonds
+    # at the last converged load (λ = 0.70, see the example's header) the whole strap is off
+    assert area[-1] == pytest.approx(HALF_WIDTH * BOND_END, rel=1e-9)
     # release is irreversible, step by step
     for a, b in zip(released, released[1:]):
         assert np.all(b[a])
@@ -181,7 +184,9 @@ def test_pulloff_debonding_starts_at_edge_4_5(pulloff):
     new = released[k] & ~before
     assert new.any()
     x = X[..., 0][new]
-    # the newly released points lie in the regions of the 4/5 edge nodes (x = 120): within one
-    # third of an element on either side, i.e. element 4's last and element 5's first Gauss column
-    assert np.all(np.abs(x - X_EDGE45) < ELEMENT_LENGTH / 3 + 1e-9), np.unique(np.round(x, 3))
+    # thesis: debonding starts in element 5 at the 4/5 edge. Released at the first failing load
+    # level (including its re-solutions): the regions of the 4/5 edge nodes (element 4's last and
+    # element 5's first Gauss column) and at most the rest of element 5
+    assert np.any(np.abs(x - X_EDGE45) < ELEMENT_LENGTH / 3), np.unique(np.round(x, 3))
+    assert np.all((x > X_EDGE45 - ELEMENT_LENGTH / 3) & (x < X_EDGE45 + ELEMENT_LENGTH)), np.unique(np.round(x, 3))
     assert np.any(x > X_EDGE45)  # bond-zone points (element 5) are among them

@@ -95,6 +95,12 @@ def _sigint_deferred(reraise: bool = True):
         raise KeyboardInterrupt
 
 
+def _version() -> str:
+    from . import __version__
+
+    return __version__
+
+
 def write_delamination_table(path: Path, steps: list[dict]) -> None:
     """delamination.csv: per converged step the load factor and, per interface, the debonded
     area and the bounding box of the debonded points (e.g. the front position of a pull-off
@@ -180,6 +186,8 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     names = [p.name for p in spec.probes]
     summary = {
         "title": spec.source.model.title,
+        "model_file": str(spec.path) if spec.path is not None else None,
+        "version": _version(),
         "units": model.units,
         "converged": False,
         "n_elements": int(model.mesh.n_elements),
