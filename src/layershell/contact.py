@@ -151,11 +151,14 @@ class ContactBlock:
         active = self.released & (g <= 0.0) if self.active is None else self.active & self.released
         a = self.alpha * self.w * active
         f = np.einsum("eq,eqm->em", a * g, self.b)
-        K = np.einsum("eq,eqm,eqn->emn", a, self.b, self.b)
+        # Σ_q a bᵀ b and Σ_q w0 Cᵀ D C as batched matrix products (BLAS) over the elements
+        K = np.matmul((self.b * a[..., None]).transpose(0, 2, 1), self.b)
         if self.alpha_T is not None and self.cap is not None:
             t, D = self.friction_traction(u_full)
             f += np.einsum("eq,eqim,eqi->em", self.w0, self.C, t)
-            K += np.einsum("eq,eqim,eqij,eqjn->emn", self.w0, self.C, D, self.C, optimize=True)
+            ne, nq, _, m = self.C.shape
+            DC = np.matmul(D * self.w0[..., None, None], self.C).reshape(ne, nq * 3, m)
+            K += np.matmul(self.C.reshape(ne, nq * 3, m).transpose(0, 2, 1), DC)
         return f, K
 
     def load_vector(self, traction: np.ndarray, F: np.ndarray) -> None:
