@@ -29,11 +29,14 @@ class Block:
     ref: LayerBlock
 
 
-def build_blocks(model: Model, dm: DofMap) -> list[Block]:
+def build_blocks(model: Model, dm: DofMap, elements: np.ndarray | None = None) -> list[Block]:
+    """One block (kernel reference data) per stack and layer, over all elements or only over
+    ``elements`` (an MPI rank's range)."""
     mesh = model.mesh
+    elements = np.arange(mesh.n_elements) if elements is None else np.asarray(elements, np.int64)
     blocks = []
     for si, stack in enumerate(model.stacks):
-        el = np.flatnonzero(model.element_stack == si)
+        el = elements[model.element_stack[elements] == si]
         if el.size == 0:
             continue
         conn = mesh.elements[el]

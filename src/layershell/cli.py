@@ -36,6 +36,14 @@ def _traceback_wanted() -> bool:
     return os.environ.get("LAYERSHELL_TRACEBACK", "") not in ("", "0")
 
 
+def _results_folder(out_dir: Path | None, model: Path, suffix: str) -> Path:
+    """``--out`` or results/<model name><suffix>; a file there is bad input."""
+    out_dir = out_dir or Path("results") / f"{model.stem}{suffix}"
+    if out_dir.exists() and not out_dir.is_dir():
+        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+    return out_dir
+
+
 def _load(model: Path):
     from .io.build import InputError, load
 
@@ -172,9 +180,7 @@ def run(
 
     if restart is not None and out_dir is None:
         out_dir = restart if restart.is_dir() else restart.parent
-    out_dir = out_dir or Path("results") / model.stem
-    if out_dir.exists() and not out_dir.is_dir():
-        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+    out_dir = _results_folder(out_dir, model, "")
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     failure: tuple[str, int] | None = None
@@ -309,9 +315,7 @@ def sweep(
     from .sweep import sweep as run_sweep
 
     pairs = [_guarded("--set", parse_assignment, a) for a in sets]
-    out_dir = out_dir or Path("results") / f"{model.stem}_sweep"
-    if out_dir.exists() and not out_dir.is_dir():
-        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+    out_dir = _results_folder(out_dir, model, "_sweep")
 
     def progress(rec):
         if not quiet:
@@ -359,9 +363,7 @@ def calibrate(
     from .calibrate import parse_param
 
     plist = [_guarded("--param", parse_param, a) for a in params]
-    out_dir = out_dir or Path("results") / f"{model.stem}_calibration"
-    if out_dir.exists() and not out_dir.is_dir():
-        _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
+    out_dir = _results_folder(out_dir, model, "_calibration")
 
     def progress(rec):
         if not quiet:

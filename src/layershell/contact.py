@@ -64,6 +64,7 @@ class ContactBlock:
     cap: np.ndarray | None = None  # (e, q) slip limit of the current step (0: no friction)
     t_n: np.ndarray | None = None  # (e, q, 3) converged tangential traction (upper on lower)
     g_p: np.ndarray | None = None  # (e, q, 3) slip anchor: t = α_T (P Δu - g_p) while sticking
+    X0: np.ndarray | None = None  # (e, q, 3) reference positions of the points (results)
 
     @classmethod
     def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float) -> "ContactBlock":
@@ -88,7 +89,7 @@ class ContactBlock:
         dofs = np.concatenate([dm.layer_dofs[itf.upper][conn][:, :, 0, :].reshape(ne, -1),
                                dm.layer_dofs[itf.lower][conn].reshape(ne, -1)], axis=1)
         return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(), alpha,
-                   np.zeros((ne, nq), bool))
+                   np.zeros((ne, nq), bool), X0=sp.X0)
 
     # ------------------------------------------------------------------ kinematics
     def relative_displacement(self, u_full: np.ndarray) -> np.ndarray:

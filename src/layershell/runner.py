@@ -284,7 +284,7 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                     rec["resolves"] = resolves["n"]
                     resolves["n"] = 0
                     rec["debonded_area"] = ctl.debonded_area()
-                    rec["debonded_extent"] = ctl.debonded_extent(model.mesh.nodes)
+                    rec["debonded_extent"] = ctl.debonded_extent()
                     summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,
                                                      **rec["debonded_area"]})
                     summary["first_delamination_load_factor"] = ctl.first_failure()

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Block, ReducedScatter
+from ..assembly import Block, ReducedScatter, build_blocks
 from ..constraints import ConstraintOperator
 from ..dofs import DofMap
-from ..element.kernel import layer_block, layer_response
+from ..element.kernel import layer_response
 from ..model import Model
 
 
@@ -55,22 +55,8 @@ def element_ranges(weights: np.ndarray, size: int) -> np.ndarray:
 
 def local_blocks(model: Model, dm: DofMap, elements: np.ndarray) -> list[Block]:
     """The layer blocks of :func:`layershell.assembly.build_blocks` restricted to ``elements``
-    (same kernel call, same arguments; only this rank's reference data is computed)."""
-    mesh = model.mesh
-    elements = np.asarray(elements, np.int64)
-    blocks = []
-    for si, stack in enumerate(model.stacks):
-        el = elements[model.element_stack[elements] == si]
-        if el.size == 0:
-            continue
-        conn = mesh.elements[el]
-        X = mesh.nodes[conn]
-        for k in stack:
-            ly = model.layers[k]
-            ref = layer_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
-                              ly.angle, ly.direction, max(model.n_thickness, ly.directors))
-            blocks.append(Block(k, el, dm.element_dofs(model, k, el), ref))
-    return blocks
+    (only this rank's reference data is computed)."""
+    return build_blocks(model, dm, elements)
 
 
 @dataclass

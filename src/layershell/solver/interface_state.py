@@ -278,27 +278,21 @@ class InterfaceController:
         vals = [r.first_failure for r in self.runs if r.first_failure is not None]
         return min(vals) if vals else None
 
-    def debonded_extent(self, nodes: np.ndarray) -> dict[str, dict[str, float]]:
+    def debonded_extent(self) -> dict[str, dict[str, float]]:
         """Per interface: released area and the bounding box (x, y) of the released interface
-        points in the reference configuration (``nodes``: mesh coordinates), None where none."""
-        from ..element.geometry import surface_points
-        from ..element.quadrature import gauss_2d
-
+        points in the reference configuration, None where none."""
+        areas = self.debonded_area()
         out = {}
         for r in self.runs:
-            blk = r.block
-            if not hasattr(blk, "_points"):
-                xi, eta = gauss_2d(int(round(np.sqrt(blk.w.shape[1]))))[0].T
-                blk._points = surface_points(nodes[blk.conn], xi, eta).X0
-            P = blk._points[blk.released]
+            P = r.block.X0[r.block.released]
             box = {f"{c}_{m}": (float(getattr(P[:, i], m)()) if P.size else None)
                    for i, c in enumerate("xy") for m in ("min", "max")}
-            out[blk.itf.name] = {"area": float((blk.w0 * blk.released).sum()), **box}
+            out[r.block.itf.name] = {"area": areas[r.block.itf.name], **box}
         return out
 
     def debonded_fraction(self) -> float:
         """Released share of all interface area (for step cutting)."""
-        a = sum(float((r.block.w0 * r.block.released).sum()) for r in self.runs)
+        a = sum(self.debonded_area().values())
         A = sum(float(r.block.w0.sum()) for r in self.runs)
         return a / A if A > 0 else 0.0
 

@@ -56,33 +56,22 @@ class Problem:
 
     def snapshot(self) -> dict:
         """Copy of the mutable delamination state (bond flags, per-point history, friction
-        anchors) to undo a load increment (step cutting)."""
-        snap: dict = {"bonded": {k: v.copy() for k, v in self.bonded.items()}, "runs": []}
-        if self.interfaces is not None:
-            snap["resolves"] = self.interfaces.resolves
-            for r in self.interfaces.runs:
-                snap["runs"].append((_copy_state(r), _copy_state(r.block)))
-        return snap
+        anchors) to undo a load increment (step cutting); the same state a checkpoint saves."""
+        if self.interfaces is None:
+            return {"bonded": {k: v.copy() for k, v in self.bonded.items()}}
+        return {"state": self.interfaces.state(self), "resolves": self.interfaces.resolves}
 
     def restore(self, snap: dict) -> None:
         """Undo to a :meth:`snapshot`; rebuilds the constraint operator."""
-        for k, v in snap["bonded"].items():
-            self.bonded[k] = v.copy()
-        if self.interfaces is not None:
-            self.interfaces.resolves = snap["resolves"]
-            for r, (rs, bs) in zip(self.interfaces.runs, snap["runs"]):
-                for obj, st in ((r, rs), (r.block, bs)):
-                    for k, v in st.items():
-                        setattr(obj, k, v.copy() if isinstance(v, np.ndarray) else v)
-            self.interfaces.sync(self)
-        self.rebuild_constraints()
+        if self.interfaces is None:
+            for k, v in snap["bonded"].items():
+                self.bonded[k] = v.copy()
+            self.rebuild_constraints()
+            return
+        self.interfaces.restore(self, snap["state"])
+        self.interfaces.resolves = snap["resolves"]  # re-solutions so far in this load step
 
     def external(self, lam: float) -> np.ndarray:
         F = lam * self.F_scaled + self.F_const
         return F if self.F_friction is None else F + self.F_friction
 
-
-def _copy_state(obj) -> dict:
-    """Array and scalar attributes of ``obj`` (copies), i.e. its mutable numeric state."""
-    return {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in vars(obj).items()
-            if isinstance(v, (np.ndarray, float, int, bool)) or v is None}
