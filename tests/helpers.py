@@ -9,14 +9,19 @@ from layershell.runner import run
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def run_example(name: str, replace: dict[str, str] | None = None, out=None):
-    """Run ``examples/<name>.toml`` (optionally with text replacements); return the RunResult."""
+def run_example(name: str, replace: dict[str, str] | None = None, out=None, newton: dict | None = None):
+    """Run ``examples/<name>.toml`` (optionally with text replacements and Newton settings
+    changed, e.g. ``newton={"semismooth_iterations": 0}``); return the RunResult."""
     path = EXAMPLES / f"{name}.toml"
     text = path.read_text()
     for a, b in (replace or {}).items():
         assert a in text, f"{a!r} not in {name}.toml"
         text = text.replace(a, b)
     spec = build(parse(text, str(path)), path.parent)
+    if newton:
+        import dataclasses
+
+        spec.newton = dataclasses.replace(spec.newton, **newton)
     return run(spec, out, write_vtu=False)
 
 

@@ -31,15 +31,22 @@ def test_contact_tangent_matches_finite_differences(rng, friction):
     pb = Problem.build(m)
     blk = pb.assembler.extra[0]
     assert blk.released.all()
+    ur = 2e-3 * rng.standard_normal(pb.op.n_red)
     if friction:
-        blk.cap = rng.uniform(0.5, 2.0, blk.w.shape)
         gp = 1e-3 * rng.standard_normal(blk.g_p.shape)
-        blk.g_p = np.einsum("eqij,eqj->eqi", blk.projector(), gp)  # anchors lie in the tangent plane
+        P = blk.projector()
+        blk.g_p = np.einsum("eqij,eqj->eqi", P, gp)  # anchors lie in the tangent plane
+        t_tr = blk.alpha_T * (np.einsum("eqij,eqj->eqi", P, blk.relative_displacement(pb.op.T @ ur)) - blk.g_p)
+        # slip limits 15-50 % above or below the trial traction: sticking and sliding points
+        factor = rng.uniform(1.15, 2.0, blk.w.shape) ** rng.choice([-1, 1], blk.w.shape)
+        blk.cap = np.linalg.norm(t_tr, axis=-1) * factor
     else:
         blk.cap = np.zeros(blk.w.shape)
-    ur = 2e-3 * rng.standard_normal(pb.op.n_red)
     g = blk.gap(pb.op.T @ ur)
     assert (g < 0).any() and (g > 0).any()  # both contact states occur
+    if friction:  # the exact return mapping: both sticking and sliding points occur
+        x = np.linalg.norm(t_tr, axis=-1) / blk.cap
+        assert (x < 0.9).any() and (x > 1.1).any()
     Kr, Kfd = fd_reduced_tangent(pb, ur, h=1e-7)
     assert np.abs(Kr - Kfd).max() < 1e-6 * np.abs(Kr).max()
     assert np.allclose(Kr, Kr.T, atol=1e-9 * np.abs(Kr).max())

@@ -167,7 +167,7 @@ def test_pulloff_debonded_area_grows(pulloff):
     # element 4's last Gauss column (weight 5/18 of the element length)
     assert area[0] == pytest.approx(HALF_WIDTH * (X_EDGE45 - ELEMENT_LENGTH * 5 / 18), rel=1e-9)
     assert area[-1] > area[0]  # the bond zone debonds
-    # at the last converged load (λ = 0.70, see the example's header) the whole strap is off
+    # at the last converged load (λ = 0.75, see the example's header) the whole strap is off
     assert area[-1] == pytest.approx(HALF_WIDTH * BOND_END, rel=1e-9)
     # release is irreversible, step by step
     for a, b in zip(released, released[1:]):

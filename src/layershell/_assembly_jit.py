@@ -150,3 +150,21 @@ def full_pattern(n, dofs, estart, vstart, scatter):  # pragma: no cover - compil
             for l in range(m):
                 scatter[base + l] = pos_of[dofs[estart[g] + l]]
     return indptr, indices
+
+
+@njit(cache=True, nogil=True)
+def scatter_add(data, scatter, start, values):  # pragma: no cover - compiled
+    """data[scatter[start + k]] += values[k]: element entries summed into the CSR data of K."""
+    for k in range(values.size):
+        data[scatter[start + k]] += values[k]
+
+
+@njit(cache=True, nogil=True)
+def max_mirror_difference(data, upper_pos, mirror_pos):  # pragma: no cover - compiled
+    """max |K_ab - K_ba| over the upper entries (the symmetry check of the reduced tangent)."""
+    m = 0.0
+    for k in range(upper_pos.size):
+        d = abs(data[upper_pos[k]] - data[mirror_pos[k]])
+        if d > m:
+            m = d
+    return m

@@ -9,10 +9,10 @@ Per step (thesis (4.22)-(4.85), with the re-equilibration the spec recommends):
      the return-mapped shear (4.71)-(4.75) as friction load;
   3. while something new failed: solve the same load level again.
 Friction (``DelaminationSettings.friction``):
-  * ``"return_mapping"`` (default): a penalty-regularised stick/slip law whose slip limit is the
-    thesis's τ^Gleit_max(g_T^max, σ33) (4.76)-(4.78), (4.84), frozen within a step; direction and
-    stick are implicit with a consistent tangent (the standard penalty-Coulomb return mapping
-    MODEL.md §10 recommends). Right after fracture the stick anchor is set so that the point
+  * ``"return_mapping"`` (default): a penalty stick/slip law (elastic stick with α_T, exact
+    return mapping onto the slip limit) whose slip limit is the thesis's τ^Gleit_max(g_T^max, σ33)
+    (4.76)-(4.78), (4.84), frozen within a step; direction and stick are implicit with a
+    consistent tangent (the standard penalty-Coulomb return mapping MODEL.md §10 recommends). Right after fracture the stick anchor is set so that the point
     transmits exactly the return-mapped shear (4.71)-(4.75).
   * ``"explicit"`` (the thesis's treatment): |τ'| = τ^Gleit_max along the last slip direction,
     applied as external loads without stiffness, updated after every converged solution.
@@ -24,7 +24,7 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from ..contact import FRICTION_SHARPNESS, ContactBlock
+from ..contact import ContactBlock, friction_shape_inverse
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
 
@@ -149,7 +149,7 @@ class InterfaceController:
                 newcap = np.where(rel & closed, law_cap, 0.0)
                 tn = np.linalg.norm(t_conv, axis=-1)
                 ratio = np.clip(tn / np.where(newcap > 0, newcap, 1.0), 0.0, 0.999)
-                x = ratio / (1.0 - ratio**FRICTION_SHARPNESS) ** (1.0 / FRICTION_SHARPNESS)  # f(x) = ratio
+                x = friction_shape_inverse(ratio)  # f(x) = ratio
                 e = t_conv / np.where(tn > 0, tn, 1.0)[..., None]
                 blk.g_p = np.where(rel[..., None], gTu - (x * newcap)[..., None] * e / blk.alpha_T, 0.0)
                 blk.cap = newcap
@@ -195,7 +195,7 @@ class InterfaceController:
                 # the friction law acts in the undeformed tangent plane (P); the mapped shear is
                 # expressed in the current basis m_α, so project it (keeps the tangent symmetric)
                 tau_rm = np.einsum("eqij,eqj->eqi", P, tau_rm)
-                x0 = (1.0 / (1.0 - 0.999 ** FRICTION_SHARPNESS) - 1.0) ** (-1.0 / FRICTION_SHARPNESS)  # f(x0) = 0.999
+                x0 = friction_shape_inverse(0.999)  # f(x0) = 0.999
                 blk.t_n = np.where(new[..., None], 0.999 * tau_rm, blk.t_n)
                 blk.g_p = np.where(new[..., None], gTu - x0 * tau_rm / blk.alpha_T, blk.g_p)
                 blk.cap = np.where(new, np.linalg.norm(tau_rm, axis=-1), blk.cap)

@@ -9,7 +9,7 @@ together with a negligible energy ``|Δu·r| ≤ tol_energy · |Δu₀·r₀|`` 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Iterator
 
 import numpy as np
@@ -28,6 +28,13 @@ class NewtonSettings:
     max_bisections: int = 8
     backend: str = "auto"
     max_active_set_loops: int = 12
+    # contact: first up to this many semi-smooth iterations (contact set from the current gap in
+    # every iteration); if they do not converge, the frozen active-set loop from the start
+    semismooth_iterations: int = 25
+    # contact: at most this many iterations per equilibrium solve in all (semi-smooth attempt and
+    # active-set loops); beyond, the increment counts as failed and is bisected - a solve that
+    # wanders that long may end on another equilibrium branch (e.g. a buckled layer pressed flat)
+    max_contact_iterations: int = 100
     line_search: bool = True
     max_line_search: int = 8
 
@@ -61,16 +68,44 @@ class ConvergenceError(RuntimeError):
 
 
 def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
-    """Equilibrium at load factor ``lam`` from ``u``; with contact, an active-set loop around
-    :func:`newton_fixed_set` (the contact set is frozen during the iterations, then checked)."""
+    """Equilibrium at load factor ``lam`` from ``u``. With contact: semi-smooth Newton first (the
+    penalty force α_N ḡ_N at ḡ_N ≤ 0 is continuous and piecewise linear in u; the contact set is
+    taken from the current gap in every iteration, so a converged residual is equilibrium with a
+    consistent set); where that does not converge in ``semismooth_iterations`` (the set cycles),
+    an active-set loop around :func:`newton_fixed_set` from ``u`` (the set is frozen during the
+    iterations, then checked)."""
     blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
     if not blocks:
         return newton_fixed_set(problem, u, lam, s)
     total = NewtonResult(False, 0)
+    if s.semismooth_iterations > 0:
+        for b in blocks:
+            b.unfreeze()
+        seen: set[bytes] = set()
+
+        def cycling(u_it: np.ndarray) -> bool:  # the contact set returns to an earlier one
+            key = b"".join(np.packbits(b.released & (b.gap(u_it) <= 0.0)).tobytes() for b in blocks)
+            again = key in seen and key != cycling.last
+            seen.add(key)
+            cycling.last = key
+            return again
+
+        cycling.last = b""
+        u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=s.semismooth_iterations),
+                                      give_up_after=6, give_up_if=cycling)
+        if res.converged:
+            return u_new, res
+        total.iterations, total.residuals = res.iterations, list(res.residuals)
+        if res.residuals and np.isfinite(res.residuals[-1]) and res.residuals[-1] < res.residuals[0]:
+            u = u_new  # go on from the semi-smooth iterate where it got closer
     for _ in range(s.max_active_set_loops):
         for b in blocks:
             b.freeze(u)
-        u_new, res = newton_fixed_set(problem, u, lam, s)
+        left = s.max_contact_iterations - total.iterations
+        if left <= 0:
+            total.message = f"no equilibrium after {total.iterations} iterations with contact"
+            break
+        u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=min(s.max_iterations, left)))
         total.iterations += res.iterations
         total.residuals += res.residuals
         total.message = res.message
@@ -88,16 +123,22 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     return u, total
 
 
-def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
-    """Equilibrium iterations at fixed load factor ``lam`` starting from ``u`` (full space)."""
+def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
+                     give_up_after: int | None = None,
+                     give_up_if: Callable[[np.ndarray], bool] | None = None) -> tuple[np.ndarray, NewtonResult]:
+    """Equilibrium iterations at fixed load factor ``lam`` starting from ``u`` (full space).
+    ``give_up_after``: stop (not converged, returning the current iterate) when that many
+    iterations have not brought the residual below its starting value; ``give_up_if(u)``: stop
+    when it returns True for the current iterate."""
     op = problem.op
     Fext = problem.external(lam)
     ref = np.linalg.norm(op.reduce(Fext))
     res = NewtonResult(False, 0)
     e0 = None
+    globalise = s.line_search and bool(problem.assembler.extra)  # contact: non-smooth
+    # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
+    f, Kr = problem.assembler.evaluate_reduced(u, op)
     for it in range(s.max_iterations + 1):
-        # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
-        f, Kr = problem.assembler.evaluate_reduced(u, op)
         r = op.reduce(Fext - f)
         rn = float(np.linalg.norm(r))
         res.residuals.append(rn)
@@ -110,6 +151,14 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         if it == s.max_iterations:
             break
+        if give_up_after is not None and it >= give_up_after and min(res.residuals[1:]) >= res.residuals[0]:
+            res.iterations = it
+            res.message = f"no progress in {it} iterations (residual {rn:.3e})"
+            return u, res
+        if give_up_if is not None and give_up_if(u):
+            res.iterations = it
+            res.message = f"given up after {it} iterations (residual {rn:.3e})"
+            return u, res
         try:
             du = problem.linear_solver(s.backend).solve(Kr, r)
         except linear.SingularSystemError as exc:
@@ -124,8 +173,20 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             return u + dU, res
-        if s.line_search and problem.assembler.extra:  # contact: non-smooth, globalise
-            dU = _line_search(problem, u, dU, Fext, rn, s)
+        if rn <= s.tol_residual ** 0.5 * scale:
+            # converging quadratically: this step most likely ends the iterations, so check the
+            # residual first and assemble the tangent only if it is needed after all
+            f_new, _ = problem.assembler.evaluate(u + dU, tangent=False)
+            if float(np.linalg.norm(op.reduce(Fext - f_new))) <= s.tol_residual * scale:
+                res.residuals.append(float(np.linalg.norm(op.reduce(Fext - f_new))))
+                res.converged, res.iterations = True, it + 1
+                return u + dU, res
+        f, Kr = problem.assembler.evaluate_reduced(u + dU, op)
+        if globalise and float(np.linalg.norm(op.reduce(Fext - f))) > rn:
+            eta = _line_search(problem, u, dU, Fext, rn, s)
+            if eta != 1.0:
+                dU = eta * dU
+                f, Kr = problem.assembler.evaluate_reduced(u + dU, op)
         u = u + dU
     res.iterations = s.max_iterations
     res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
@@ -133,19 +194,19 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
 
 
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
-                 s: NewtonSettings) -> np.ndarray:
-    """Backtracking on the residual norm: the full Newton step unless it increases the residual;
-    then halve it (at most ``max_line_search`` times) until the residual decreases. If no step
-    length helps, the full step is kept (Newton may still recover)."""
+                 s: NewtonSettings) -> float:
+    """Backtracking on the residual norm after the full Newton step increased it: halve the step
+    (at most ``max_line_search`` times) until the residual decreases and return that step length.
+    If no step length helps, 1 (the full step is kept; Newton may still recover)."""
     op = problem.op
-    eta = 1.0
-    for _ in range(s.max_line_search):
+    eta = 0.5
+    for _ in range(s.max_line_search - 1):
         f, _ = problem.assembler.evaluate(u + eta * dU, tangent=False)
         r = float(np.linalg.norm(op.reduce(Fext - f)))
         if r <= rn:
-            return eta * dU
+            return eta
         eta *= 0.5
-    return dU
+    return 1.0
 
 
 @dataclass

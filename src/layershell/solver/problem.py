@@ -50,8 +50,9 @@ class Problem:
         from .linear import LinearSolver
 
         if backend not in self.solvers:
-            # contact/delamination: penalty-stiffened, ill-conditioned, partly unsymmetric tangents
-            self.solvers[backend] = LinearSolver(backend, symmetric=self.interfaces is None)
+            # PARDISO's symmetric mode wherever K_r is symmetric (checked per call); friction
+            # tangents that are not fall back to the general mode
+            self.solvers[backend] = LinearSolver(backend, symmetric=True)
         return self.solvers[backend]
 
     def snapshot(self) -> dict:
