@@ -377,7 +377,7 @@ class InterfaceDef(Strict):
 
 class DelaminationDef(Strict):
     friction: Literal["return_mapping", "explicit"] = Field(
-        "return_mapping", description="friction as a regularised return mapping, or as explicit loads (thesis)")
+        "return_mapping", description="friction as a penalty return mapping (implicit), or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
     max_resolves: PositiveInt = 100
     max_debond_fraction: float | None = Field(

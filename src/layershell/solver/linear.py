@@ -3,12 +3,13 @@
 ``pardiso``: Intel MKL PARDISO through ``pypardiso`` (installed by default on x86-64), used in its
 *real symmetric indefinite* mode (mtype = -2, upper triangle) where the tangent is symmetric - it
 is not always positive definite (buckling, limit points) - and in its general mode (mtype = 11)
-where friction makes it unsymmetric (checked on every call, O(nnz)). With contact/delamination the
-problem uses the general mode throughout: the penalty-stiffened tangents are so ill-conditioned
-that the symmetric mode's pivot perturbation (1e-8) changes the Newton path (measured on the §5.1
-plate: 126 instead of 24 iterations in the first debonding step). The symbolic analysis (fill-reducing
-ordering) is kept and reused while the sparsity pattern does not change - every Newton iteration
-of a bond state has the same pattern - and only the numerical factorisation is redone.
+where it is not (checked on every call, O(nnz)). With the exact friction return mapping the
+contact tangents are symmetric too; with the earlier smooth friction law the symmetric mode's
+pivot perturbation (1e-8) once changed the Newton path on the penalty-stiffened tangents (126
+instead of 24 iterations in a debonding step of the §5.1 plate), which no longer occurs. The
+symbolic analysis (fill-reducing ordering) is kept and reused while the sparsity pattern does not
+change - every Newton iteration of a bond state has the same pattern - and only the numerical
+factorisation is redone.
 
 ``superlu``: SciPy's SuperLU (always available), the automatic fallback. COLAMD ordering: on the
 multi-layer shell tangents it fills 2-6x less than MMD(AᵀA + A) (measured in
