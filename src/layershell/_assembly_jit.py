@@ -168,3 +168,14 @@ def max_mirror_difference(data, upper_pos, mirror_pos):  # pragma: no cover - co
         if d > m:
             m = d
     return m
+
+
+@njit(cache=True, nogil=True)
+def max_abs(data):  # pragma: no cover - compiled
+    """max |data| without a temporary array."""
+    m = 0.0
+    for k in range(data.size):
+        d = abs(data[k])
+        if d > m:
+            m = d
+    return m

@@ -67,8 +67,9 @@ class ReducedScatter:
     """Pattern of K_r = Tᵀ K T and the map ``P (nnz_r × nnz)`` with ``K_r.data = P @ K.data``.
 
     Entry p = (i, j) of K contributes ``T[i, a] T[j, b] K_p`` to entry (a, b) of K_r
-    (3.69)-(3.72). P is stored column-wise (CSC: one column per entry of K), which is the
-    order in which the contributions are generated, so it is built without sorting.
+    (3.69)-(3.72). P is built column-wise (CSC: one column per entry of K, the order in which
+    the contributions are generated, so without sorting) and stored row-wise (CSR) for the
+    product.
     The pattern is structural (no value-dependent cancellation), hence fixed for a bond state.
     Compiled loops (``_assembly_jit``) when Numba is available, vectorised NumPy otherwise
     (``jit=False`` forces the NumPy path).
@@ -212,6 +213,13 @@ class ReducedTangent(sp.csr_matrix):
         if jit_mod is not None:
             return float(jit_mod.max_mirror_difference(self.data, rs.upper_pos, rs.mirror_pos))
         return float(np.max(np.abs(self.data[rs.upper_pos] - self.data[rs.mirror_pos])))
+
+    def max_abs(self) -> float:
+        """Largest |entry| (compiled, no temporary)."""
+        jit_mod = _jit()
+        if jit_mod is None or self.nnz == 0:
+            return float(np.abs(self.data).max()) if self.nnz else 0.0
+        return float(jit_mod.max_abs(self.data))
 
     def upper_triangle(self) -> sp.csr_matrix | None:
         """The upper triangle with every diagonal entry stored, sorted CSR (None where the maps
