@@ -163,3 +163,15 @@ def test_semismooth_contact_newton_equals_frozen_active_sets():
     assert semi.summary["debonded_area"][-1]["concrete/trc"] > 0
     its = [sum(s["iterations"] for s in r.summary["steps"]) for r in (semi, frozen)]
     assert its[0] <= its[1], its
+
+
+def test_contact_iteration_cap_from_the_model_file():
+    """[steps] max_contact_iterations reaches the Newton settings: a cap of 8 makes the runner
+    bisect the first increment of the §5.1 plate (14 iterations otherwise, no bisection) and
+    stops the re-equilibration after the first debonding with a message that names the
+    setting; the converged step is kept."""
+    capped = run_example("cantilever_plate_slip", {"n = 24": "factors = [0.5, 0.6]\nmax_contact_iterations = 8"})
+    assert not capped.converged and "max_contact_iterations" in capped.message
+    assert capped.summary["steps"][0]["bisections"] >= 1
+    plain = run_example("cantilever_plate_slip", {"n = 24": "factors = [0.5, 0.6]"})
+    assert plain.converged and all(st["bisections"] == 0 for st in plain.summary["steps"])

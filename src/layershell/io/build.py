@@ -679,7 +679,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         raise InputError("'steps.solver': 'pardiso' needs the package pypardiso (pip install "
                          "pypardiso; x86-64 only); install it or use solver = 'auto' or 'superlu'")
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
-                            max_bisections=st.max_bisections, backend=st.solver)
+                            max_bisections=st.max_bisections, backend=st.solver,
+                            max_contact_iterations=st.max_contact_iterations)
     _interfaces(mf, model, index, layers)
     from .probes import build_probes
 

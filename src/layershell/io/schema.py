@@ -306,6 +306,9 @@ class Steps(Strict):
     tolerance: PositiveFloat = 1e-8
     max_iterations: PositiveInt = Field(25, le=10_000)
     max_bisections: int = Field(8, ge=0, le=30)
+    max_contact_iterations: PositiveInt = Field(
+        100, le=100_000, description="models with contact: Newton iterations per equilibrium solve in all "
+        "(semi-smooth and active-set loops) before the load increment is bisected")
     solver: Literal["auto", "superlu", "pardiso"] = "auto"
 
 

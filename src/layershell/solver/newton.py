@@ -95,7 +95,8 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             return again
 
         cycling.last = b""
-        u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=s.semismooth_iterations),
+        n_semi = min(s.semismooth_iterations, s.max_contact_iterations)
+        u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=n_semi),
                                       give_up_after=6, give_up_if=cycling)
         if res.converged:
             return u_new, res
@@ -107,7 +108,8 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             b.freeze(u)
         left = s.max_contact_iterations - total.iterations
         if left <= 0:
-            total.message = f"no equilibrium after {total.iterations} iterations with contact"
+            total.message = (f"no equilibrium after {total.iterations} iterations with contact "
+                             "([steps] max_contact_iterations)")
             break
         u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=min(s.max_iterations, left)))
         total.iterations += res.iterations
