@@ -116,6 +116,9 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         total.residuals += res.residuals
         total.message = res.message
         if not res.converged:
+            if total.iterations >= s.max_contact_iterations:
+                total.message = (f"no equilibrium after {total.iterations} iterations with contact "
+                                 "([steps] max_contact_iterations)")
             break
         u = u_new
         if not any(b.set_changed(u) for b in blocks):
