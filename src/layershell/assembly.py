@@ -90,13 +90,9 @@ class ReducedScatter:
         np.cumsum(cnt, out=col_ptr[1:])
         del cnt
         total = int(col_ptr[-1])
-        jit_mod = None
-        if jit is not False:
-            try:
-                from . import _assembly_jit as jit_mod
-            except ImportError:  # pragma: no cover - Numba missing
-                if jit:
-                    raise
+        jit_mod = None if jit is False else _jit()
+        if jit and jit_mod is None:  # pragma: no cover - Numba missing
+            raise ImportError("jit=True needs Numba (layershell._assembly_jit)")
         if jit_mod is not None:
             Tt = T.T.tocsr()
             Tt.sort_indices()
@@ -216,10 +212,10 @@ class ReducedTangent(sp.csr_matrix):
 
     def max_abs(self) -> float:
         """Largest |entry| (compiled, no temporary)."""
+        if self.nnz == 0:
+            return 0.0
         jit_mod = _jit()
-        if jit_mod is None or self.nnz == 0:
-            return float(np.abs(self.data).max()) if self.nnz else 0.0
-        return float(jit_mod.max_abs(self.data))
+        return float(jit_mod.max_abs(self.data) if jit_mod is not None else np.abs(self.data).max())
 
     def upper_triangle(self) -> sp.csr_matrix | None:
         """The upper triangle with every diagonal entry stored, sorted CSR (None where the maps
@@ -253,10 +249,7 @@ class Assembler:
         n = self.dm.n_full
         blocks = [*self.blocks, *self.extra]
         self.n_entries = int(sum(b.dofs.shape[0] * b.dofs.shape[1] ** 2 for b in blocks))
-        try:
-            from . import _assembly_jit as jit_mod
-        except ImportError:  # pragma: no cover - Numba missing
-            jit_mod = None
+        jit_mod = _jit()
         if jit_mod is not None and blocks:
             dofs = np.concatenate([b.dofs.ravel() for b in blocks]).astype(np.int64)
             m = np.concatenate([np.full(b.dofs.shape[0], b.dofs.shape[1], np.int64) for b in blocks])

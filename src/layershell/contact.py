@@ -34,17 +34,17 @@ from .model import Model
 FRICTION_SHARPNESS = float("inf")
 
 
-def friction_shape(x: np.ndarray, k: float | None = None) -> tuple[np.ndarray, np.ndarray]:
-    """f(x)/x and f'(x) of the friction regularisation f (x = |t_trial| / slip limit)."""
-    k = FRICTION_SHARPNESS if k is None else k
+def friction_shape(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """f(x)/x and f'(x) of the friction limit shape f (x = |t_trial| / slip limit)."""
+    k = FRICTION_SHARPNESS
     if np.isinf(k):
         return 1.0 / np.maximum(x, 1.0), (x < 1.0).astype(float)
     return (1.0 + x**k) ** (-1.0 / k), (1.0 + x**k) ** (-1.0 / k - 1.0)
 
 
-def friction_shape_inverse(ratio: np.ndarray | float, k: float | None = None):
+def friction_shape_inverse(ratio: np.ndarray | float):
     """x with f(x) = ratio (0 ≤ ratio < 1)."""
-    k = FRICTION_SHARPNESS if k is None else k
+    k = FRICTION_SHARPNESS
     if np.isinf(k):
         return ratio
     return ratio / (1.0 - ratio**k) ** (1.0 / k)

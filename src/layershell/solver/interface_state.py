@@ -12,8 +12,9 @@ Friction (``DelaminationSettings.friction``):
   * ``"return_mapping"`` (default): a penalty stick/slip law (elastic stick with α_T, exact
     return mapping onto the slip limit) whose slip limit is the thesis's τ^Gleit_max(g_T^max, σ33)
     (4.76)-(4.78), (4.84), frozen within a step; direction and stick are implicit with a
-    consistent tangent (the standard penalty-Coulomb return mapping MODEL.md §10 recommends). Right after fracture the stick anchor is set so that the point
-    transmits exactly the return-mapped shear (4.71)-(4.75).
+    consistent tangent (the standard penalty-Coulomb return mapping MODEL.md §10 recommends).
+    Right after fracture the stick anchor is set so that the point transmits exactly the
+    return-mapped shear (4.71)-(4.75).
   * ``"explicit"`` (the thesis's treatment): |τ'| = τ^Gleit_max along the last slip direction,
     applied as external loads without stiffness, updated after every converged solution.
 In both, σ33 is the contact pressure and there is no friction where the gap is open.

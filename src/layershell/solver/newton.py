@@ -29,7 +29,7 @@ class NewtonSettings:
     backend: str = "auto"
     max_active_set_loops: int = 12
     # contact: first up to this many semi-smooth iterations (contact set from the current gap in
-    # every iteration); if they do not converge, the frozen active-set loop from the start
+    # every iteration); if they do not converge, the frozen active-set loop (see ``newton``)
     semismooth_iterations: int = 25
     # contact: at most this many iterations per equilibrium solve in all (semi-smooth attempt and
     # active-set loops); beyond, the increment counts as failed and is bisected - a solve that
@@ -86,15 +86,16 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         for b in blocks:
             b.unfreeze()
         seen: set[bytes] = set()
+        last = b""
 
         def cycling(u_it: np.ndarray) -> bool:  # the contact set returns to an earlier one
+            nonlocal last
             key = b"".join(np.packbits(b.released & (b.gap(u_it) <= 0.0)).tobytes() for b in blocks)
-            again = key in seen and key != cycling.last
+            again = key in seen and key != last
             seen.add(key)
-            cycling.last = key
+            last = key
             return again
 
-        cycling.last = b""
         n_semi = min(s.semismooth_iterations, s.max_contact_iterations)
         u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=n_semi),
                                       give_up_after=6, give_up_if=cycling)
@@ -108,8 +109,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             b.freeze(u)
         left = s.max_contact_iterations - total.iterations
         if left <= 0:
-            total.message = (f"no equilibrium after {total.iterations} iterations with contact "
-                             "([steps] max_contact_iterations)")
+            total.message = _contact_cap_message(total.iterations)
             break
         u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=min(s.max_iterations, left)))
         total.iterations += res.iterations
@@ -117,8 +117,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         total.message = res.message
         if not res.converged:
             if total.iterations >= s.max_contact_iterations:
-                total.message = (f"no equilibrium after {total.iterations} iterations with contact "
-                                 "([steps] max_contact_iterations)")
+                total.message = _contact_cap_message(total.iterations)
             break
         u = u_new
         if not any(b.set_changed(u) for b in blocks):
@@ -130,6 +129,10 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     for b in blocks:
         b.unfreeze()
     return u, total
+
+
+def _contact_cap_message(iterations: int) -> str:
+    return f"no equilibrium after {iterations} iterations with contact ([steps] max_contact_iterations)"
 
 
 def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
@@ -186,8 +189,9 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             # converging quadratically: this step most likely ends the iterations, so check the
             # residual first and assemble the tangent only if it is needed after all
             f_new, _ = problem.assembler.evaluate(u + dU, tangent=False)
-            if float(np.linalg.norm(op.reduce(Fext - f_new))) <= s.tol_residual * scale:
-                res.residuals.append(float(np.linalg.norm(op.reduce(Fext - f_new))))
+            rn_new = float(np.linalg.norm(op.reduce(Fext - f_new)))
+            if rn_new <= s.tol_residual * scale:
+                res.residuals.append(rn_new)
                 res.converged, res.iterations = True, it + 1
                 return u + dU, res
         f, Kr = problem.assembler.evaluate_reduced(u + dU, op)
