@@ -85,7 +85,7 @@ def one(n: int, directors: int, backend: str) -> dict:
         solver = linear.PardisoSymmetric() if sym else linear.PardisoGeneral()
         A = solver.matrix(Kr)
         b = np.asfortranarray(r)
-        solver._s._check_A(A)
+        A = solver._check(A)
         t_conv = time.perf_counter() - t0
         times = []
         for phase in (11, 22, 33):

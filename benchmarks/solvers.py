@@ -70,12 +70,12 @@ def pardiso(K, r, general: bool, repeat: int) -> dict:
     s = linear.PardisoGeneral() if general else linear.PardisoSymmetric()
     A = s.matrix(K)
     b = np.asfortranarray(r)
-    s._s._check_A(A)
+    A = s._check(A)
     ta, _ = best(lambda: s._call(A, 11, b), 1)
     tf, _ = best(lambda: s._call(A, 22, b), repeat)
     x = s._call(A, 33, b)
     fnnz = int(s._s.iparm[17])
-    s._s.free_memory(everything=True)
+    s.release()
     return {"analysis_s": ta, "factor_s": tf, "factor_nnz": fnnz, "fill": fnnz / K.nnz,
             "residual": float(np.linalg.norm(K @ x - r) / np.linalg.norm(r))}
 

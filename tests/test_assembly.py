@@ -108,7 +108,9 @@ def test_pattern_maps_detect_unsymmetric_values_and_fall_back(rng):
     assert linear.is_symmetric(K2)
     rows = np.repeat(np.arange(Kr.shape[0]), np.diff(Kr.indptr))
     off = np.flatnonzero(Kr.indices != rows)[0]
+    assert Kr.known_symmetric  # assembled from symmetric contributions: the solver skips the check
     Kr.data[off] += 1e-6 * np.abs(Kr.data).max()
+    Kr.known_symmetric = False  # values changed by hand
     assert Kr.symmetry_error() >= 0.9e-6 * np.abs(Kr.data).max()
     assert not linear.is_symmetric(Kr)
 
@@ -154,3 +156,18 @@ def test_compiled_scatter_equals_numpy_fallback(rng, monkeypatch):
     assert np.allclose(f1, f2, rtol=0, atol=1e-12 * np.abs(f2).max())
     assert np.allclose(K1.data, K2.data, rtol=0, atol=1e-12 * np.abs(K2.data).max())
     assert abs(e1 - K2.symmetry_error()) <= 1e-12 * np.abs(K2.data).max()
+
+
+def test_symmetry_is_checked_unless_every_block_declares_it(rng, monkeypatch):
+    """Contact blocks declare symmetric tangents, so the assembled K_r skips the solver's check;
+    a block that does not declare it brings the O(nnz) check back (with the same answer here)."""
+    from layershell.contact import ContactBlock
+
+    pb = Problem.build(_three_layers())
+    assert pb.assembler.extra
+    u = pb.op.expand(1e-2 * rng.standard_normal(pb.op.n_red))
+    _, Kr = pb.assembler.evaluate_reduced(u, pb.op)
+    assert Kr.known_symmetric and Kr.symmetry_error() <= 1e-13 * np.abs(Kr.data).max()
+    monkeypatch.setattr(ContactBlock, "symmetric", False)
+    _, K2 = pb.assembler.evaluate_reduced(u, pb.op)
+    assert not K2.known_symmetric and linear.is_symmetric(K2)

@@ -64,3 +64,56 @@ def test_gap_is_zero_where_bonded_and_measures_separation(rng):
     u2 = u.copy()
     u2[d] += 0.01
     assert np.allclose(blk.gap(u2), 0.01)
+
+
+def test_response_equals_the_explicit_operator_form(rng):
+    """The response works with C = c ⊗ I₃; it equals the explicit sums with C and b = A3·C:
+    f = Σ_q α_N w ḡ_N b + w0 Cᵀ t, K = Σ_q α_N w b⊗b + w0 Cᵀ D C (4.56)-(4.59)."""
+    m = _two_layer()
+    m.interface_laws = {1: InterfaceLaw(1.0, 1.0, alpha_N=5e3)}
+    m.initially_debonded = {1: np.arange(m.mesh.n_nodes)}
+    pb = Problem.build(m)
+    blk = pb.assembler.extra[0]
+    u = pb.op.T @ (2e-3 * rng.standard_normal(pb.op.n_red))
+    assert np.array_equal(blk.C, np.einsum("eqk,ij->eqikj", blk.c, np.eye(3)).reshape(blk.C.shape))
+    blk.cap = np.full(blk.w.shape, 0.3)
+    g = blk.gap(u)
+    a = blk.alpha * blk.w * (g <= 0)
+    t, D = blk.friction_traction(u)
+    f_ref = np.einsum("eq,eqm->em", a * g, blk.b) + np.einsum("eq,eqim,eqi->em", blk.w0, blk.C, t)
+    K_ref = (np.einsum("eq,eqm,eqn->emn", a, blk.b, blk.b)
+             + np.einsum("eq,eqim,eqij,eqjn->emn", blk.w0, blk.C, D, blk.C))
+    f, K = blk.response(u)
+    assert (g < 0).any()
+    assert np.allclose(f, f_ref, rtol=1e-12, atol=1e-12 * np.abs(f_ref).max())
+    assert np.allclose(K, K_ref, rtol=1e-12, atol=1e-12 * np.abs(K_ref).max())
+    f2, none = blk.response(u, tangent=False)
+    assert none is None and np.array_equal(f2, f)
+
+
+def test_compact_contact_tangent_scatters_like_the_full_one(rng, monkeypatch):
+    """Only elements with released points contribute to the contact tangent; scattering just
+    those (compiled and NumPy paths) gives the tangent of the full block."""
+    import layershell.assembly as assembly
+
+    mesh = rectangle(2.0, 0.8, 3, 1)
+    th = np.full(mesh.n_nodes, 0.1)
+    layers = [Layer("a", Orthotropic.isotropic(100.0, 0.2), 2, th), Layer("b", Orthotropic.isotropic(300.0, 0.3), 3, th)]
+    m = Model(mesh, layers, [(0, 1)], np.zeros(3, int), fixes=[Fix(np.flatnonzero(mesh.nodes[:, 0] < 1e-9), 0, (0,), (0, 1, 2))],
+              nonlinear=True)
+    m.interface_laws = {1: InterfaceLaw(1.0, 1.0, alpha_N=5e3)}
+    m.initially_debonded = {1: np.flatnonzero(mesh.nodes[:, 0] < 0.5)}  # the first element's left half
+    pb = Problem.build(m)
+    blk = pb.assembler.extra[0]
+    assert 0 < np.count_nonzero(blk.released.any(axis=1)) < blk.released.shape[0]
+    u = pb.op.T @ (2e-3 * rng.standard_normal(pb.op.n_red))
+    blk.cap = np.full(blk.w.shape, 0.3)
+    f1, K1 = pb.assembler.evaluate_reduced(u, pb.op)
+    monkeypatch.setattr(ContactBlock, "compact_tangent", False)
+    f2, K2 = pb.assembler.evaluate_reduced(u, pb.op)
+    monkeypatch.setattr(ContactBlock, "compact_tangent", True)
+    monkeypatch.setattr(assembly, "_jit", lambda: None)
+    f3, K3 = pb.assembler.evaluate_reduced(u, pb.op)
+    scale = np.abs(K2.data).max()
+    assert np.abs(K1 - K2).max() <= 1e-12 * scale and np.abs(K3 - K2).max() <= 1e-12 * scale
+    assert np.array_equal(f1, f2) and np.allclose(f3, f2, rtol=0, atol=1e-12 * np.abs(f2).max())

@@ -160,6 +160,16 @@ def scatter_add(data, scatter, start, values):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True)
+def scatter_add_elements(data, scatter, start, values, elements, m2):  # pragma: no cover - compiled
+    """The same for a subset of a block's elements: element ``elements[s]`` owns the m2 entries
+    from ``start + elements[s] * m2``, its values are ``values[s * m2:(s + 1) * m2]``."""
+    for s in range(elements.size):
+        base = start + elements[s] * m2
+        for k in range(m2):
+            data[scatter[base + k]] += values[s * m2 + k]
+
+
+@njit(cache=True, nogil=True)
 def max_mirror_difference(data, upper_pos, mirror_pos):  # pragma: no cover - compiled
     """max |K_ab - K_ba| over the upper entries (the symmetry check of the reduced tangent)."""
     m = 0.0
@@ -168,6 +178,15 @@ def max_mirror_difference(data, upper_pos, mirror_pos):  # pragma: no cover - co
         if d > m:
             m = d
     return m
+
+
+@njit(cache=True, nogil=True)
+def gather(data, pos):  # pragma: no cover - compiled
+    """data[pos] for an int32 ``pos`` (NumPy would first convert the index array to int64)."""
+    out = np.empty(pos.size, data.dtype)
+    for k in range(pos.size):
+        out[k] = data[pos[k]]
+    return out
 
 
 @njit(cache=True, nogil=True)

@@ -112,7 +112,7 @@ class ReducedScatter:
         # built by columns (entries of K), applied by rows: CSR halves the time of P @ K.data
         self.P = sp.csc_matrix((w_all, q_all, col_ptr.astype(_index_dtype(total))), shape=(self.nnz, nnz)).tocsr()
         del w_all, q_all, col_ptr
-        # --- upper triangle (PARDISO's symmetric mode) and the mirror of each upper entry
+        # --- upper triangle (PARDISO's symmetric mode); the mirror of each upper entry on first use
         red_rows = np.repeat(np.arange(n_red, dtype=it), np.diff(self.indptr))
         up = self.indices >= red_rows
         self.upper_pos = np.flatnonzero(up).astype(it)
@@ -121,19 +121,34 @@ class ReducedScatter:
         np.cumsum(np.bincount(red_rows[up], minlength=n_red), out=self.upper_indptr[1:])
         up_rows = red_rows[up]
         del red_rows, up
-        if self.nnz == 0:
-            mirror = np.zeros(0, np.int64)
-        elif jit_mod is not None:
-            mirror = jit_mod.mirror_positions(self.indptr, self.indices, self.upper_pos, up_rows)
-        else:
-            keys = np.repeat(np.arange(n_red, dtype=np.int64), np.diff(self.indptr)) * n_red + self.indices
-            tk = self.upper_indices.astype(np.int64) * n_red + up_rows
-            mirror = np.minimum(np.searchsorted(keys, tk), max(self.nnz - 1, 0))
-            mirror[keys[mirror] != tk] = -1
-            del keys, tk
-        self.mirror_pos = mirror.astype(it) if self.nnz == 0 or mirror.min() >= 0 else None
         if int(np.count_nonzero(self.upper_indices == up_rows)) != n_red:
             self.upper_indices = None  # a diagonal entry is missing: PARDISO needs them, general path
+        self._mirror: np.ndarray | None | bool = False  # computed on first use (symmetry checks only)
+
+    @property
+    def mirror_pos(self) -> np.ndarray | None:
+        """For each upper entry (a, b) the position of (b, a) (None where the pattern lacks one);
+        built on first use: only the symmetry check needs it, and assembled tangents of
+        symmetric contributions skip that check."""
+        if self._mirror is False:
+            n_red = self.shape[0]
+            it = self.indices.dtype
+            rows = np.repeat(np.arange(n_red, dtype=it), np.diff(self.indptr))
+            up_rows = rows[self.upper_pos]
+            del rows
+            jit_mod = _jit()
+            if self.nnz == 0:
+                mirror = np.zeros(0, np.int64)
+            elif jit_mod is not None:
+                mirror = jit_mod.mirror_positions(self.indptr, self.indices, self.upper_pos, up_rows)
+            else:
+                keys = np.repeat(np.arange(n_red, dtype=np.int64), np.diff(self.indptr)) * n_red + self.indices
+                tk = self.indices[self.upper_pos].astype(np.int64) * n_red + up_rows
+                mirror = np.minimum(np.searchsorted(keys, tk), max(self.nnz - 1, 0))
+                mirror[keys[mirror] != tk] = -1
+                del keys, tk
+            self._mirror = mirror.astype(it) if self.nnz == 0 or mirror.min() >= 0 else None
+        return self._mirror
 
     def _map_numpy(self, T, indptr, indices, rows, nT, col_ptr, chunk):
         """Vectorised pattern and map (fallback without Numba): the pattern as the symbolic product
@@ -170,17 +185,20 @@ class ReducedScatter:
             w_all[s0:s1] = tv[ta] * tv[tb]
         return q_all, w_all
 
-    def matrix(self, data_full: np.ndarray) -> "ReducedTangent":
-        """K_r for the values ``data_full`` of the full-space pattern."""
+    def matrix(self, data_full: np.ndarray, symmetric: bool = False) -> "ReducedTangent":
+        """K_r for the values ``data_full`` of the full-space pattern; ``symmetric``: every
+        contribution is symmetric by construction (no check needed by the solver)."""
         K = ReducedTangent((self.P @ data_full, self.indices, self.indptr), shape=self.shape)
         K.indices, K.indptr = self.indices, self.indptr  # share (SciPy may copy them): no copy per iteration
         K.has_sorted_indices = True
         K.scatter = self
+        K.known_symmetric = symmetric
         return K
 
     def memory_bytes(self) -> int:
         arrays = [self.P.data, self.P.indices, self.P.indptr, self.indices, self.indptr, self.upper_pos,
-                  self.mirror_pos, self.upper_indices, self.upper_indptr]
+                  self._mirror if isinstance(self._mirror, np.ndarray) else None, self.upper_indices,
+                  self.upper_indptr]
         return sum(a.nbytes for a in arrays if a is not None)
 
 
@@ -191,6 +209,10 @@ class ReducedTangent(sp.csr_matrix):
     the maps and take the general path."""
 
     scatter: ReducedScatter | None = None
+    #: assembled from symmetric contributions only (element tangents, contact blocks declaring
+    #: ``symmetric``): the solver skips its O(nnz) symmetry check. Cleared when ``data`` is
+    #: changed by hand.
+    known_symmetric: bool = False
 
     def _maps(self) -> ReducedScatter | None:
         rs = self.scatter
@@ -223,7 +245,9 @@ class ReducedTangent(sp.csr_matrix):
         rs = self._maps()
         if rs is None or rs.upper_indices is None:
             return None
-        A = sp.csr_matrix((self.data[rs.upper_pos], rs.upper_indices, rs.upper_indptr), shape=self.shape)
+        jit_mod = _jit()
+        vals = jit_mod.gather(self.data, rs.upper_pos) if jit_mod is not None else self.data[rs.upper_pos]
+        A = sp.csr_matrix((vals, rs.upper_indices, rs.upper_indptr), shape=self.shape)
         A.has_sorted_indices = True
         return A
 
@@ -305,8 +329,21 @@ class Assembler:
             data = np.zeros(self.nnz) if jit_mod is not None else np.empty(self.n_entries)
         pos = 0
 
-        def add(Ke) -> None:
+        def add(Ke, ne: int | None = None) -> None:
+            """Element matrices (e, m, m) at the next entries, or ``(values, elements)`` for a
+            subset of the block's ``ne`` elements (the others are zero)."""
             nonlocal pos
+            if isinstance(Ke, tuple):
+                vals, el = Ke
+                m2 = vals.shape[1] * vals.shape[2]
+                flat = np.ascontiguousarray(vals).reshape(-1)
+                if jit_mod is not None:
+                    jit_mod.scatter_add_elements(data, self.scatter, pos, flat, el.astype(np.int64), m2)
+                else:
+                    data[pos:pos + ne * m2] = 0.0
+                    data[pos:pos + ne * m2].reshape(ne, m2)[el] = flat.reshape(-1, m2)
+                pos += ne * m2
+                return
             flat = np.ascontiguousarray(Ke).reshape(-1)
             if jit_mod is not None:  # sum straight into the CSR data (no entry array, no bincount)
                 jit_mod.scatter_add(data, self.scatter, pos, flat)
@@ -323,10 +360,11 @@ class Assembler:
                 if tangent:
                     add(Ke)
         for b in self.extra:
-            fe, Ke = b.response(u_full, tangent)
+            compact = getattr(b, "compact_tangent", False)
+            fe, Ke = b.response(u_full, tangent, compact=True) if compact else b.response(u_full, tangent)
             f += np.bincount(b.dofs.ravel(), weights=fe.ravel(), minlength=n)
             if tangent:
-                add(Ke)
+                add(Ke, b.dofs.shape[0])
         if not tangent:
             return f, None
         if jit_mod is None:
@@ -347,4 +385,10 @@ class Assembler:
         K_r = Tᵀ K T of constraint operator ``op`` (3.69)-(3.72), by the cached reduced scatter."""
         rs = self.reduced_scatter(op)
         f, data = self._values(u_full, True)
-        return f, rs.matrix(data)
+        return f, rs.matrix(data, symmetric=self.symmetric)
+
+    @property
+    def symmetric(self) -> bool:
+        """Every contribution to K is symmetric: the element tangents are (Bᵀ C B and the
+        geometric term), extra blocks declare it (``symmetric = True``)."""
+        return all(getattr(b, "symmetric", False) for b in self.extra)

@@ -86,6 +86,18 @@ class ContactBlock:
     t_n: np.ndarray | None = None  # (e, q, 3) converged tangential traction (upper on lower)
     g_p: np.ndarray | None = None  # (e, q, 3) slip anchor: t = α_T (P Δu - g_p) while sticking
     X0: np.ndarray | None = None  # (e, q, 3) reference positions of the points (results)
+    # c (e, q, k), k = m/3: C = c ⊗ I₃ (C_iM = c_k δ_ij for M = 3k + j), the scalar weights of the
+    # nodal directors in Δu; the response works with c (a third of C's size, 1/9 of its products)
+    c: np.ndarray | None = None
+    #: the tangent is symmetric (normal penalty α_N b⊗b, friction α_T P or α_T cap/|t_tr| (I-e⊗e)P
+    #: with e in the tangent plane): PARDISO's symmetric mode needs no check
+    symmetric = True
+    #: ``response(..., compact=True)`` gives the tangent of the elements with released points only
+    compact_tangent = True
+
+    def __post_init__(self) -> None:
+        if self.c is None:
+            self.c = np.ascontiguousarray(self.C[:, :, 0, 0::3])
 
     @classmethod
     def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float) -> "ContactBlock":
@@ -109,8 +121,11 @@ class ContactBlock:
         b = np.einsum("eqi,eqim->eqm", sp.A3, C)
         dofs = np.concatenate([dm.layer_dofs[itf.upper][conn][:, :, 0, :].reshape(ne, -1),
                                dm.layer_dofs[itf.lower][conn].reshape(ne, -1)], axis=1)
+        c = np.concatenate([np.broadcast_to(sp.N, (ne, nq, 9)),
+                            -np.einsum("qn,enl->eqnl", sp.N, H[..., None] ** np.arange(d + 1)).reshape(ne, nq, -1)],
+                           axis=2)
         return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(), alpha,
-                   np.zeros((ne, nq), bool), X0=sp.X0)
+                   np.zeros((ne, nq), bool), X0=sp.X0, c=np.ascontiguousarray(c))
 
     # ------------------------------------------------------------------ kinematics
     def relative_displacement(self, u_full: np.ndarray) -> np.ndarray:
@@ -142,7 +157,7 @@ class ContactBlock:
         """P = I - A3 ⊗ A3: tangential part along the undeformed normal, (e, q, 3, 3)."""
         return np.eye(3) - np.einsum("eqi,eqj->eqij", self.A3, self.A3)
 
-    def friction_traction(self, u_full: np.ndarray):
+    def friction_traction(self, u_full: np.ndarray, du: np.ndarray | None = None):
         """Penalty friction by return mapping: with the trial t_tr = α_T (P Δu - g_p) the traction is
         t = cap f(|t_tr|/cap) t_tr/|t_tr| with f(x) = min(x, 1) (FRICTION_SHARPNESS = inf): stick
         with the stiffness α_T below the slip limit ``cap``, sliding at the limit beyond, i.e. the
@@ -150,9 +165,10 @@ class ContactBlock:
         addition to the thesis, which applies friction as loads). Returns t (e, q, 3) (force of
         the upper layer on the lower one per area) and its consistent tangent dt/dΔu (e, q, 3, 3):
         α_T P sticking, α_T cap/|t_tr| (I - e⊗e) P sliding (symmetric: e lies in the tangent
-        plane)."""
+        plane). ``du``: the relative displacement at ``u_full`` if already known."""
         P = self.projector()
-        gT = np.einsum("eqij,eqj->eqi", P, self.relative_displacement(u_full))
+        du = self.relative_displacement(u_full) if du is None else du
+        gT = np.einsum("eqij,eqj->eqi", P, du)
         t_tr = self.alpha_T * (gT - self.g_p)
         n = np.linalg.norm(t_tr, axis=-1)
         on = self.released & (self.cap > 0)
@@ -165,23 +181,41 @@ class ContactBlock:
         D = self.alpha_T * np.einsum("eqij,eqjk->eqik", dtdtr, P) * on[..., None, None]
         return t_tr * (f_over_x * on)[..., None], D
 
-    def response(self, u_full: np.ndarray, tangent: bool = True):
+    def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False):
         """Penalty contact (and, with return-mapping friction, the tangential traction): internal
-        force (e, m) and tangent (e, m, m) at released points (None when not ``tangent``)."""
-        g = self.gap(u_full)
+        force (e, m) and tangent (e, m, m) at released points (None when not ``tangent``).
+        ``compact``: the tangent as ``(K_sub, elements)`` for the elements with a released
+        point only (the others contribute nothing; the assembler scatters just these).
+
+        With C = c ⊗ I₃ both are sums over the points of one 3-vector T_q and one 3×3 matrix
+        M_q: f_(k,i) = Σ_q c_qk T_qi and K_(k,i)(l,j) = Σ_q c_qk c_ql M_qij, where
+        T = a ḡ_N A3 + w0 t and M = a A3⊗A3 + w0 dt/dΔu (a = α_N w at contact points)."""
+        ne, nq, nk = self.c.shape
+        U = u_full[self.dofs].reshape(ne, nk, 3)
+        du = np.matmul(self.c, U)  # (e, q, 3) relative displacement (4.43)
+        g = np.einsum("eqi,eqi->eq", self.A3, du)  # ḡ_N (4.45)
         active = self.released & (g <= 0.0) if self.active is None else self.active & self.released
         a = self.alpha * self.w * active
-        f = np.einsum("eq,eqm->em", a * g, self.b)
-        # Σ_q a bᵀ b and Σ_q w0 Cᵀ D C as batched matrix products (BLAS) over the elements
-        K = np.matmul((self.b * a[..., None]).transpose(0, 2, 1), self.b) if tangent else None
-        if self.alpha_T is not None and self.cap is not None:
-            t, D = self.friction_traction(u_full)
-            f += np.einsum("eq,eqim,eqi->em", self.w0, self.C, t)
-            if not tangent:
-                return f, None
-            ne, nq, _, m = self.C.shape
-            DC = np.matmul(D * self.w0[..., None, None], self.C).reshape(ne, nq * 3, m)
-            K += np.matmul(self.C.reshape(ne, nq * 3, m).transpose(0, 2, 1), DC)
+        T = (a * g)[..., None] * self.A3
+        friction = self.alpha_T is not None and self.cap is not None
+        if friction:
+            t, D = self.friction_traction(u_full, du)
+            T += self.w0[..., None] * t
+        f = np.matmul(self.c.transpose(0, 2, 1), T).reshape(ne, 3 * nk)
+        if not tangent:
+            return f, None
+        el = np.flatnonzero(self.released.any(axis=1))
+        M = a[el, :, None, None] * self.A3[el, :, :, None] * self.A3[el, :, None, :]
+        if friction:
+            M += self.w0[el, :, None, None] * D[el]
+        # Σ_q c_q ⊗ (c_q ⊗ M_q) as one batched product over the points, in (k, i, l, j) order
+        c = self.c[el]
+        cM = (c[:, :, None, :, None] * M[:, :, :, None, :]).reshape(el.size, nq, 9 * nk)
+        Ks = np.matmul(c.transpose(0, 2, 1), cM).reshape(el.size, 3 * nk, 3 * nk)
+        if compact:
+            return f, (Ks, el)
+        K = np.zeros((ne, 3 * nk, 3 * nk))
+        K[el] = Ks
         return f, K
 
     def load_vector(self, traction: np.ndarray, F: np.ndarray) -> None:

@@ -20,6 +20,7 @@ the 5 099-DOF pull-off tangent in 0.02 s against 0.6 s (SuperLU/COLAMD) and 3.5 
 """
 from __future__ import annotations
 
+import ctypes
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,6 +78,8 @@ class FactorInfo:
 def is_symmetric(K: sp.spmatrix, rtol: float = 1e-12) -> bool:
     """Whether K equals its transpose to ``rtol`` of its largest entry (friction tangents are not
     symmetric)."""
+    if getattr(K, "known_symmetric", False):  # assembly.ReducedTangent of symmetric contributions
+        return True
     fast = getattr(K, "symmetry_error", None)  # assembly.ReducedTangent: O(nnz) via its pattern maps
     err = fast() if fast is not None else None
     if err is not None:
@@ -86,19 +89,58 @@ def is_symmetric(K: sp.spmatrix, rtol: float = 1e-12) -> bool:
     return d.nnz == 0 or d.max() <= rtol * abs(K).max()
 
 
+# fill-reducing orderings of PARDISO (iparm[1]); "auto" analyses the first pattern of a solver
+# with both up to AUTO_ORDERING_MAX_DOFS and keeps the one whose factorisation needs fewer flops
+ORDERINGS = {"metis": 3, "mmd": 0}
+AUTO_ORDERING_MAX_DOFS = 50_000
+
+
 class PardisoSymmetric:
-    """MKL PARDISO for a symmetric (indefinite) matrix, reusing the symbolic analysis."""
+    """MKL PARDISO for a symmetric (indefinite) matrix, reusing the symbolic analysis.
+
+    PARDISO is called directly (through pypardiso's handle on MKL) with zero-based CSR indices,
+    so the int32 index arrays of the reduced pattern are passed without a copy per call, and
+    with explicit parameters (``pardisoinit`` defaults, then the ordering). The fill-reducing
+    ordering is chosen per solver (``ordering="auto"``): on the layered-shell tangents minimum
+    degree fills less than METIS up to about 2·10⁴ DOFs (pull-off 335 against 452 MFLOP per
+    factorisation, 22 473-DOF plate 5.3 against 7.0 GFLOP) and more above (88 k DOFs: 64.6
+    against 52.6 GFLOP), so the first pattern up to ``AUTO_ORDERING_MAX_DOFS`` is analysed with
+    both and the cheaper one kept for every later pattern (``benchmarks/solvers.py``)."""
 
     MTYPE = -2
 
-    def __init__(self) -> None:
+    def __init__(self, ordering: str = "auto") -> None:
         import pypardiso
 
         backend_name("pardiso")
+        if ordering != "auto" and ordering not in ORDERINGS:
+            raise ValueError(f"unknown PARDISO ordering {ordering!r}; use auto, {', '.join(ORDERINGS)}")
         self._s = pypardiso.PyPardisoSolver(mtype=self.MTYPE)
+        self._init_parameters()
+        self.ordering = ordering
+        self._ordering: int | None = None if ordering == "auto" else ORDERINGS[ordering]
         self._indptr: np.ndarray | None = None
         self._indices: np.ndarray | None = None
         self.info = FactorInfo("pardiso")
+
+    def _init_parameters(self) -> None:
+        """MKL's defaults for this matrix type (``pardisoinit``), zero-based indices."""
+        s = self._s
+        ip = s.iparm
+        try:
+            s.libmkl.pardisoinit(s.pt.ctypes.data_as(ctypes.c_void_p), ctypes.byref(ctypes.c_int32(self.MTYPE)),
+                                 ip.ctypes.data_as(ctypes.c_void_p))
+        except AttributeError:  # pragma: no cover - every MKL exports it
+            ip[:] = 0
+            ip[[0, 1, 7, 9, 17, 18]] = [1, 3, 2, 8 if self.MTYPE == -2 else 13, -1, -1]
+            ip[20] = 1 if self.MTYPE == -2 else 0
+            ip[10] = ip[12] = 0 if self.MTYPE == -2 else 1
+        ip[34] = 1  # zero-based CSR indices
+        # iterative refinement only after perturbed pivots (pardisoinit asks for 2 steps after
+        # every solve): the extra steps cost 6 ms per pull-off solve and, on the penalty-stiffened
+        # contact tangents, lengthened the Newton paths (pull-off 460 against 425 iterations,
+        # §5.1 strong 409 against 132, slip 203 against 136; the same results)
+        ip[7] = 0
 
     def matrix(self, K: sp.spmatrix) -> sp.csr_matrix:
         return self.upper(K)
@@ -118,27 +160,93 @@ class PardisoSymmetric:
         A.sort_indices()
         return A
 
+    def _check(self, A: sp.csr_matrix) -> sp.csr_matrix:
+        """Sorted CSR, float64, int32 indices, no empty row (PARDISO would fail or crash)."""
+        if A.shape[0] != A.shape[1] or not sp.issparse(A) or A.format != "csr":
+            raise ValueError("PARDISO needs a square CSR matrix")
+        if not A.has_sorted_indices:
+            A.sort_indices()
+        if A.dtype != np.float64:
+            A = A.astype(np.float64)
+        if A.indptr.dtype != np.int32 or A.indices.dtype != np.int32:
+            A = sp.csr_matrix((A.data, A.indices.astype(np.int32), A.indptr.astype(np.int32)), shape=A.shape)
+        if not np.diff(A.indptr).all():
+            raise SingularSystemError("the matrix has an empty row (a DOF without stiffness)")
+        return A
+
     def _call(self, A: sp.csr_matrix, phase: int, b: np.ndarray) -> np.ndarray:
-        self._s.set_phase(phase)
-        return self._s._call_pardiso(A, b)
+        """One PARDISO phase (11 analysis, 22 factorisation, 33 solve, -1 release) on ``A``
+        (checked by :meth:`_check`); the analysis picks the ordering (see the class)."""
+        if phase == 11:
+            self._analyse(A, b)
+            return np.zeros_like(b)
+        return self._raw(A, phase, b)
+
+    def _raw(self, A: sp.csr_matrix, phase: int, b: np.ndarray) -> np.ndarray:
+        from pypardiso.pardiso_wrapper import PyPardisoError
+
+        s = self._s
+        if phase == 11:
+            s.iparm[17] = s.iparm[18] = -1  # report the factor's size and flops (overwritten by each report)
+        b = np.asfortranarray(b, dtype=float)
+        x = np.zeros_like(b)
+        err = ctypes.c_int32(0)
+        i32 = ctypes.POINTER(ctypes.c_int32)
+        f64 = ctypes.POINTER(ctypes.c_double)
+        s._mkl_pardiso(s.pt.ctypes.data_as(ctypes.POINTER(s._pt_type[0])),
+                       ctypes.byref(ctypes.c_int32(1)), ctypes.byref(ctypes.c_int32(1)),
+                       ctypes.byref(ctypes.c_int32(self.MTYPE)), ctypes.byref(ctypes.c_int32(phase)),
+                       ctypes.byref(ctypes.c_int32(A.shape[0])), A.data.ctypes.data_as(f64),
+                       A.indptr.ctypes.data_as(i32), A.indices.ctypes.data_as(i32), s.perm.ctypes.data_as(i32),
+                       ctypes.byref(ctypes.c_int32(1 if b.ndim == 1 else b.shape[1])),
+                       s.iparm.ctypes.data_as(i32), ctypes.byref(ctypes.c_int32(0)),
+                       b.ctypes.data_as(f64), x.ctypes.data_as(f64), ctypes.byref(err))
+        if err.value != 0:
+            raise PyPardisoError(err.value)
+        return x
+
+    def _analyse(self, A: sp.csr_matrix, b: np.ndarray) -> None:
+        ip = self._s.iparm
+        if self._ordering is None:  # "auto": the first pattern decides
+            if A.shape[0] > AUTO_ORDERING_MAX_DOFS:
+                self._ordering = ORDERINGS["metis"]
+            else:
+                flops = {}
+                for name, code in ORDERINGS.items():
+                    ip[1] = code
+                    self._raw(A, 11, b)
+                    flops[code] = int(ip[18])
+                    self._free()
+                self._ordering = min(flops, key=flops.get)
+        ip[1] = self._ordering
+        self._raw(A, 11, b)
+
+    def _free(self) -> None:
+        empty = sp.csr_matrix((np.zeros(0), np.zeros(0, np.int32), np.zeros(1, np.int32)), shape=(0, 0))
+        self._raw(empty, -1, np.zeros(0))
 
     def solve(self, K: sp.spmatrix, r: np.ndarray) -> np.ndarray:
         from pypardiso.pardiso_wrapper import PyPardisoError
 
-        A = self.matrix(K)
+        A = self._check(self.matrix(K))
         b = np.asfortranarray(r, dtype=float)
         same = (self._indptr is not None and np.array_equal(A.indptr, self._indptr)
                 and np.array_equal(A.indices, self._indices))
-        self._s._check_A(A)
         try:
             if not same:
                 if self._indptr is not None:
-                    self._s.free_memory(everything=True)
-                self._call(A, 11, b)  # symbolic analysis (ordering)
+                    self._free()
+                    self._indptr = None
+                self._analyse(A, b)  # symbolic analysis (ordering)
                 self._indptr, self._indices = A.indptr.copy(), A.indices.copy()
-            self._call(A, 22, b)  # numerical factorisation
-            x = self._call(A, 33, b)  # solve with iterative refinement
+            self._raw(A, 22, b)  # numerical factorisation
+            x = self._raw(A, 33, b)  # solve with iterative refinement
         except PyPardisoError as exc:
+            if self._indptr is not None:
+                try:
+                    self._free()
+                except PyPardisoError:  # pragma: no cover - nothing left to release
+                    pass
             self._indptr = None
             raise SingularSystemError(f"PARDISO failed ({exc})") from exc
         ip = self._s.iparm
@@ -146,9 +254,9 @@ class PardisoSymmetric:
         return x
 
     def release(self) -> None:
-        if self._indptr is not None:
-            self._s.free_memory(everything=True)
-            self._indptr = None
+        """Free PARDISO's memory (factors and analysis)."""
+        self._free()
+        self._indptr = None
 
 
 class PardisoGeneral(PardisoSymmetric):

@@ -148,8 +148,11 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     res = NewtonResult(False, 0)
     e0 = None
     globalise = s.line_search and bool(problem.assembler.extra)  # contact: non-smooth
-    # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
-    f, Kr = problem.assembler.evaluate_reduced(u, op)
+    # forces first, the tangent only where an iteration needs it: an iteration that converges,
+    # and every trial step of the line search, costs one force evaluation (about 1/15 of a
+    # tangent evaluation on the pull-off model) instead of a tangent that is thrown away
+    asm = problem.assembler
+    f, _ = asm.evaluate(u, tangent=False)
     for it in range(s.max_iterations + 1):
         r = op.reduce(Fext - f)
         rn = float(np.linalg.norm(r))
@@ -171,6 +174,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.iterations = it
             res.message = f"given up after {it} iterations (residual {rn:.3e})"
             return u, res
+        # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
+        _, Kr = asm.evaluate_reduced(u, op)
         try:
             du = problem.linear_solver(s.backend).solve(Kr, r)
         except linear.SingularSystemError as exc:
@@ -185,21 +190,11 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             return u + dU, res
-        if rn <= s.tol_residual ** 0.5 * scale:
-            # converging quadratically: this step most likely ends the iterations, so check the
-            # residual first and assemble the tangent only if it is needed after all
-            f_new, _ = problem.assembler.evaluate(u + dU, tangent=False)
-            rn_new = float(np.linalg.norm(op.reduce(Fext - f_new)))
-            if rn_new <= s.tol_residual * scale:
-                res.residuals.append(rn_new)
-                res.converged, res.iterations = True, it + 1
-                return u + dU, res
-        f, Kr = problem.assembler.evaluate_reduced(u + dU, op)
+        f, _ = asm.evaluate(u + dU, tangent=False)
         if globalise and float(np.linalg.norm(op.reduce(Fext - f))) > rn:
-            eta = _line_search(problem, u, dU, Fext, rn, s)
+            eta, f_eta = _line_search(problem, u, dU, Fext, rn, s)
             if eta != 1.0:
-                dU = eta * dU
-                f, Kr = problem.assembler.evaluate_reduced(u + dU, op)
+                dU, f = eta * dU, f_eta
         u = u + dU
     res.iterations = s.max_iterations
     res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
@@ -207,19 +202,20 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
 
 
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
-                 s: NewtonSettings) -> float:
+                 s: NewtonSettings) -> tuple[float, np.ndarray | None]:
     """Backtracking on the residual norm after the full Newton step increased it: halve the step
-    (at most ``max_line_search`` times) until the residual decreases and return that step length.
-    If no step length helps, 1 (the full step is kept; Newton may still recover)."""
+    (at most ``max_line_search`` times) until the residual decreases; returns that step length
+    and the internal force there. If no step length helps, ``(1, None)`` (the full step is kept;
+    Newton may still recover)."""
     op = problem.op
     eta = 0.5
     for _ in range(s.max_line_search - 1):
         f, _ = problem.assembler.evaluate(u + eta * dU, tangent=False)
         r = float(np.linalg.norm(op.reduce(Fext - f)))
         if r <= rn:
-            return eta
+            return eta, f
         eta *= 0.5
-    return 1.0
+    return 1.0, None
 
 
 @dataclass
