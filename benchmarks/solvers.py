@@ -6,10 +6,12 @@ Tangents K_r = Tᵀ K T at u = 0 (λ = 0) of examples/pulloff.toml, examples/can
 and of the two-layer d = 3 plate of benchmarks/scaling.py with ``--plate`` elements per side.
 For each: SciPy SuperLU with COLAMD and with MMD_AT_PLUS_A ordering, MKL PARDISO in the real
 symmetric indefinite mode (mtype -2, upper triangle, as used by linear.py) and in the general
-mode (mtype 11, used where friction makes the tangent unsymmetric). Reported: factorisation
+mode (mtype 11, used where a tangent is not symmetric); the symmetric mode with both orderings
+(METIS nested dissection and minimum degree: ``linear.PardisoSymmetric(ordering="auto")``
+analyses a solver's first pattern with both and keeps the one with fewer flops). Reported: factorisation
 seconds (PARDISO: symbolic analysis and numerical factorisation separately; the analysis is done
 once per bond state and reused), factor nonzeros, fill = factor nonzeros / nnz(K_r) (a symmetric
-factor stores one triangle), and the relative residual of one solve. Best of ``--repeat`` runs.
+factor stores one triangle), PARDISO's factorisation MFLOP, and the relative residual of one solve. Best of ``--repeat`` runs.
 Last line: ``solvers {json}``.
 """
 from __future__ import annotations
@@ -64,19 +66,19 @@ def superlu(K, r, spec: str, repeat: int) -> dict:
             "residual": float(np.linalg.norm(K @ x - r) / np.linalg.norm(r))}
 
 
-def pardiso(K, r, general: bool, repeat: int) -> dict:
+def pardiso(K, r, general: bool, repeat: int, ordering: str = "metis") -> dict:
     from layershell.solver import linear
 
-    s = linear.PardisoGeneral() if general else linear.PardisoSymmetric()
+    s = linear.PardisoGeneral(ordering) if general else linear.PardisoSymmetric(ordering)
     A = s.matrix(K)
     b = np.asfortranarray(r)
     A = s._check(A)
     ta, _ = best(lambda: s._call(A, 11, b), 1)
     tf, _ = best(lambda: s._call(A, 22, b), repeat)
     x = s._call(A, 33, b)
-    fnnz = int(s._s.iparm[17])
+    fnnz, mflop = int(s._s.iparm[17]), int(s._s.iparm[18])
     s.release()
-    return {"analysis_s": ta, "factor_s": tf, "factor_nnz": fnnz, "fill": fnnz / K.nnz,
+    return {"analysis_s": ta, "factor_s": tf, "factor_nnz": fnnz, "fill": fnnz / K.nnz, "mflop": mflop,
             "residual": float(np.linalg.norm(K @ x - r) / np.linalg.norm(r))}
 
 
@@ -99,7 +101,7 @@ def main() -> None:
     have_pardiso = linear.backend_name("auto") == "pardiso"
     load = os.getloadavg()
     print(f"# {os.cpu_count()} CPUs, load average {load[0]:.2f} {load[1]:.2f} {load[2]:.2f}; best of {a.repeat}")
-    print(f"{'case':<34} {'dofs':>8} {'nnz':>10} {'solver':<22} {'analysis_s':>10} {'factor_s':>9} "
+    print(f"{'case':<34} {'dofs':>8} {'nnz':>10} {'solver':<30} {'analysis_s':>10} {'factor_s':>9} "
           f"{'factor_nnz':>11} {'fill':>6} {'residual':>9}")
     results = []
     for case, make in cases.items():
@@ -108,13 +110,14 @@ def main() -> None:
         if K.shape[0] <= a.mmd_max_dofs:
             runs["superlu MMD_AT_PLUS_A"] = lambda: superlu(K, r, "MMD_AT_PLUS_A", a.repeat)
         if have_pardiso:
-            runs["pardiso symmetric (-2)"] = lambda: pardiso(K, r, False, a.repeat)
+            runs["pardiso symmetric (-2) metis"] = lambda: pardiso(K, r, False, a.repeat, "metis")
+            runs["pardiso symmetric (-2) mmd"] = lambda: pardiso(K, r, False, a.repeat, "mmd")
             runs["pardiso general (11)"] = lambda: pardiso(K, r, True, a.repeat)
         for solver, fn in runs.items():
             res = fn()
             row = {"case": case, "dofs": K.shape[0], "nnz": K.nnz, "solver": solver, **res}
             results.append(row)
-            print(f"{case:<34} {K.shape[0]:>8} {K.nnz:>10} {solver:<22} {res.get('analysis_s', 0.0):>10.3f} "
+            print(f"{case:<34} {K.shape[0]:>8} {K.nnz:>10} {solver:<30} {res.get('analysis_s', 0.0):>10.3f} "
                   f"{res['factor_s']:>9.3f} {res['factor_nnz']:>11} {res['fill']:>6.2f} {res['residual']:>9.1e}",
                   flush=True)
     print("solvers " + json.dumps({"load_average": round(load[0], 2), "cpus": os.cpu_count(),

@@ -1,22 +1,24 @@
 """Sparse linear solves of the reduced tangent, with automatic backend choice.
 
-``pardiso``: Intel MKL PARDISO through ``pypardiso`` (installed by default on x86-64), used in its
-*real symmetric indefinite* mode (mtype = -2, upper triangle) where the tangent is symmetric - it
-is not always positive definite (buckling, limit points) - and in its general mode (mtype = 11)
-where it is not (checked on every call, O(nnz)). With the exact friction return mapping the
-contact tangents are symmetric too; with the earlier smooth friction law the symmetric mode's
-pivot perturbation (1e-8) once changed the Newton path on the penalty-stiffened tangents (126
-instead of 24 iterations in a debonding step of the §5.1 plate), which no longer occurs. The
-symbolic analysis (fill-reducing ordering) is kept and reused while the sparsity pattern does not
-change - every Newton iteration of a bond state has the same pattern - and only the numerical
-factorisation is redone.
+``pardiso``: Intel MKL PARDISO (through ``pypardiso``'s handle on MKL, installed by default on
+x86-64), used in its *real symmetric indefinite* mode (mtype = -2, upper triangle) where the
+tangent is symmetric - it is not always positive definite (buckling, limit points) - and in its
+general mode (mtype = 11) where it is not. Assembled tangents whose contributions are all
+symmetric by construction (element tangents, contact with the exact friction return mapping)
+say so (``ReducedTangent.known_symmetric``); other matrices are checked on every call (O(nnz)).
+The symbolic analysis (fill-reducing ordering) is kept and reused while the sparsity pattern
+does not change - every Newton iteration of a bond state has the same pattern - and only the
+numerical factorisation is redone. PARDISO is called with explicit parameters (MKL's
+``pardisoinit`` defaults, zero-based indices, the ordering picked by measured flops, iterative
+refinement only after perturbed pivots; see :class:`PardisoSymmetric`).
 
 ``superlu``: SciPy's SuperLU (always available), the automatic fallback. COLAMD ordering: on the
 multi-layer shell tangents it fills 2-6x less than MMD(AᵀA + A) (measured in
 ``benchmarks/solvers.py``).
 
 Measured on this project's models (2-core machine, ``benchmarks/solvers.py``): PARDISO factorises
-the 5 099-DOF pull-off tangent in 0.02 s against 0.6 s (SuperLU/COLAMD) and 3.5 s (SuperLU/MMD).
+the 5 099-DOF pull-off tangent in 0.024 s (minimum-degree ordering; 0.034 s with METIS) against
+0.6 s (SuperLU/COLAMD) and 3.5 s (SuperLU/MMD).
 """
 from __future__ import annotations
 
