@@ -57,3 +57,43 @@ def test_singular_system_is_reported(backend):
 def test_unknown_backend_is_rejected():
     with pytest.raises(ValueError, match="unknown linear solver"):
         linear.backend_name("umfpack")
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="pypardiso/MKL not available")
+def test_pardiso_parameters_take_effect_and_auto_ordering_takes_the_cheaper():
+    """PARDISO is called with its parameters applied (iparm[0] = 1): the two orderings give
+    different factors, "auto" keeps the one with fewer flops (and the solution is the same),
+    refinement runs only after perturbed pivots, and indices are zero-based."""
+    # a 3-DOF-per-node shell-like pattern, where the orderings differ
+    K = sp.kron(_laplacian_2d(14, 0.5), np.ones((3, 3)) + 3 * np.eye(3)).tocsr()
+    r = np.random.default_rng(1).normal(size=K.shape[0])
+    stats = {}
+    for name in ("metis", "mmd"):
+        s = linear.PardisoSymmetric(ordering=name)
+        x = s.solve(K, r)
+        assert np.allclose(K @ x, r, rtol=1e-9, atol=1e-9 * np.abs(r).max())
+        stats[name] = (int(s._s.iparm[17]), int(s._s.iparm[18]))
+        ip = s._s.iparm
+        assert ip[0] == 1 and ip[34] == 1 and ip[7] == 0 and ip[1] == linear.ORDERINGS[name]
+        s.release()
+    assert stats["metis"] != stats["mmd"]  # the ordering parameter reached PARDISO
+    auto = linear.PardisoSymmetric()
+    x = auto.solve(K, r)
+    best = min(stats, key=lambda k: stats[k][1])
+    assert auto._s.iparm[1] == linear.ORDERINGS[best]
+    assert np.allclose(K @ x, r, rtol=1e-9, atol=1e-9 * np.abs(r).max())
+    with pytest.raises(ValueError, match="ordering"):
+        linear.PardisoSymmetric(ordering="amd")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_unsymmetric_matrix_takes_the_general_path(backend):
+    K = _laplacian_2d(9, 0.7).tolil()
+    K[3, 4] += 0.3  # unsymmetric
+    K = K.tocsr()
+    r = np.random.default_rng(2).normal(size=K.shape[0])
+    s = linear.LinearSolver(backend)
+    x = s.solve(K, r)
+    assert np.allclose(x, np.linalg.solve(K.toarray(), r), rtol=1e-9, atol=1e-12)
+    if backend == "pardiso":
+        assert list(s._pardiso) == [False]  # general mode (mtype 11) only
