@@ -36,6 +36,11 @@ class SingularSystemError(RuntimeError):
     """The reduced tangent is singular (a rigid-body mode is not supported, or a limit point)."""
 
 
+# what PardisoSymmetric uses of pypardiso's solver object (its handle on MKL): checked once, so
+# that a pypardiso release without them falls back to SciPy instead of failing mid-run
+_PYPARDISO_ATTRIBUTES = ("_mkl_pardiso", "_pt_type", "pt", "perm", "iparm", "libmkl")
+
+
 def _have_pardiso() -> bool:
     try:
         import os
@@ -44,6 +49,9 @@ def _have_pardiso() -> bool:
 
         # point later solver instances straight at the library instead of searching again
         os.environ.setdefault("PYPARDISO_MKL_RT", pypardiso.ps.libmkl._name)
+        if not all(hasattr(pypardiso.ps, a) for a in _PYPARDISO_ATTRIBUTES):
+            return False
+        getattr(pypardiso.ps.libmkl, "pardisoinit")
     except Exception:
         return False
     return True
@@ -126,17 +134,12 @@ class PardisoSymmetric:
         self.info = FactorInfo("pardiso")
 
     def _init_parameters(self) -> None:
-        """MKL's defaults for this matrix type (``pardisoinit``), zero-based indices."""
+        """MKL's defaults for this matrix type (``pardisoinit``, checked by :func:`backend_name`),
+        zero-based indices."""
         s = self._s
         ip = s.iparm
-        try:
-            s.libmkl.pardisoinit(s.pt.ctypes.data_as(ctypes.c_void_p), ctypes.byref(ctypes.c_int32(self.MTYPE)),
-                                 ip.ctypes.data_as(ctypes.c_void_p))
-        except AttributeError:  # pragma: no cover - every MKL exports it
-            ip[:] = 0
-            ip[[0, 1, 7, 9, 17, 18]] = [1, 3, 2, 8 if self.MTYPE == -2 else 13, -1, -1]
-            ip[20] = 1 if self.MTYPE == -2 else 0
-            ip[10] = ip[12] = 0 if self.MTYPE == -2 else 1
+        s.libmkl.pardisoinit(s.pt.ctypes.data_as(ctypes.c_void_p), ctypes.byref(ctypes.c_int32(self.MTYPE)),
+                             ip.ctypes.data_as(ctypes.c_void_p))
         ip[34] = 1  # zero-based CSR indices
         # iterative refinement only after perturbed pivots (pardisoinit asks for 2 steps after
         # every solve): the extra steps cost 6 ms per pull-off solve and, on the penalty-stiffened
