@@ -173,6 +173,9 @@ class PardisoSymmetric:
             A.sort_indices()
         if A.dtype != np.float64:
             A = A.astype(np.float64)
+        if A.nnz >= np.iinfo(np.int32).max:
+            raise ValueError(f"the tangent has {A.nnz} stored entries, more than the 32-bit indices of "
+                             "PARDISO allow; use a coarser mesh or fewer directors")
         if A.indptr.dtype != np.int32 or A.indices.dtype != np.int32:
             A = sp.csr_matrix((A.data, A.indices.astype(np.int32), A.indptr.astype(np.int32)), shape=A.shape)
         if not np.diff(A.indptr).all():
