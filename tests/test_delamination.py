@@ -175,3 +175,31 @@ def test_contact_iteration_cap_from_the_model_file():
     assert capped.summary["steps"][0]["bisections"] >= 1
     plain = run_example("cantilever_plate_slip", {"n = 24": "factors = [0.5, 0.6]"})
     assert plain.converged and all(st["bisections"] == 0 for st in plain.summary["steps"])
+
+
+@pytest.mark.parametrize("name", ["cantilever_plate_bonded", "cantilever_plate_slip"])
+def test_every_assembled_tangent_is_used_by_a_solve(name, monkeypatch):
+    """Newton assembles K only where an iteration goes on (forces first): every tangent
+    evaluation is followed by one linear solve - none is thrown away at convergence or by the
+    line search - with and without contact."""
+    from layershell.assembly import Assembler
+    from layershell.solver.linear import LinearSolver
+
+    counts = {"tangent": 0, "solve": 0}
+    ev, so = Assembler.evaluate_reduced, LinearSolver.solve
+
+    def evaluate_reduced(self, *a, **k):
+        counts["tangent"] += 1
+        return ev(self, *a, **k)
+
+    def solve(self, *a, **k):
+        counts["solve"] += 1
+        return so(self, *a, **k)
+
+    monkeypatch.setattr(Assembler, "evaluate_reduced", evaluate_reduced)
+    monkeypatch.setattr(LinearSolver, "solve", solve)
+    r = run_example(name, {"n = 24": "factors = [0.5, 0.6]"})
+    assert r.converged
+    its = sum(s["iterations"] for s in r.summary["steps"])
+    assert counts["solve"] > 0 and counts["tangent"] == counts["solve"]
+    assert counts["solve"] <= its + 2 * len(r.summary["steps"])  # round-off-floor exits solve once more
