@@ -1,7 +1,7 @@
 """Delamination and contact through the whole pipeline (MODEL.md §9-§10, issue 4)."""
 import numpy as np
 import pytest
-from helpers import run_example
+from helpers import EXAMPLES, run_example
 
 from layershell.delamination import InterfaceLaw
 from layershell.interfaces import interface_state, interfaces
@@ -203,3 +203,32 @@ def test_every_assembled_tangent_is_used_by_a_solve(name, monkeypatch):
     its = sum(s["iterations"] for s in r.summary["steps"])
     assert counts["solve"] > 0 and counts["tangent"] == counts["solve"]
     assert counts["solve"] <= its + 2 * len(r.summary["steps"])  # round-off-floor exits solve once more
+
+
+def test_without_reequilibration_releases_act_from_the_next_step():
+    """[delamination] reequilibrate = false (the thesis's procedure, MODEL.md §9): no
+    re-solution at the load level of a release. The step where the §5.1 plate first debonds
+    then reports the equilibrium before the release - equal to the bonded plate's - while the
+    default re-solves it with the released strip (softer)."""
+    from layershell.io.build import InputError, build, parse
+
+    steps = {"n = 24": "factors = [0.5, 0.55, 0.6]"}
+    thesis = run_example("cantilever_plate_slip", {**steps, "[steps]": "[delamination]\nreequilibrate = false\n\n[steps]"})
+    default = run_example("cantilever_plate_slip", steps)
+    bonded = run_example("cantilever_plate_bonded", steps)
+    assert thesis.converged and default.converged
+    assert all(s["resolves"] == 0 for s in thesis.summary["steps"])
+    assert sum(s["resolves"] for s in default.summary["steps"]) > 0
+    assert thesis.summary["first_delamination_load_factor"] == default.summary["first_delamination_load_factor"] == 0.55
+
+    def w(r, i):
+        return r.summary["steps"][i]["probes"]["w_front_max"]
+
+    assert w(thesis, 1) == pytest.approx(w(bonded, 1), rel=1e-9)  # λ = 0.55: released, not yet re-solved
+    assert w(default, 1) > w(bonded, 1) * (1 + 1e-4)
+    assert w(thesis, 2) > w(bonded, 2) * (1 + 1e-4)  # λ = 0.6 is solved with the released strip
+    # step cutting measures the re-solutions, which this procedure has not: refused with a clear message
+    text = (EXAMPLES / "cantilever_plate_slip.toml").read_text().replace(
+        "[steps]", "[delamination]\nreequilibrate = false\nmax_debond_fraction = 0.1\n\n[steps]")
+    with pytest.raises(InputError, match="reequilibrate"):
+        build(parse(text, "x.toml"))

@@ -507,8 +507,11 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             if zone_law is not None:
                 model.initial_laws[k] = zone_law
     d = mf.delamination
+    if not d.reequilibrate and d.max_debond_fraction is not None:
+        raise InputError("'delamination.max_debond_fraction' measures the debonding of the re-solutions at one "
+                         "load level; with 'delamination.reequilibrate = false' there are none: remove one of them")
     model.delamination = DelaminationSettings(d.max_release, d.max_resolves, d.friction,
-                                             d.max_debond_fraction, d.max_debond_cuts)
+                                             d.max_debond_fraction, d.max_debond_cuts, d.reequilibrate)
 
 
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:

@@ -389,6 +389,10 @@ class DelaminationDef(Strict):
                     "interface area is undone and halved (the delamination state is then updated at every "
                     "sub-step); off when not given")
     max_debond_cuts: int = Field(4, ge=0, le=20, description="most halvings per load step for max_debond_fraction")
+    reequilibrate: bool = Field(
+        True, description="solve the same load level again after releases until nothing new fails (recommended); "
+                          "false: the thesis's procedure, releases act from the next load step on (the front then "
+                          "lags by up to one step per release and depends more on the step size)")
 
 
 class OutputDef(Strict):

@@ -55,6 +55,9 @@ class DelaminationSettings:
     # area is undone and its load increment halved (at most ``max_debond_cuts`` times per step)
     max_debond_fraction: float | None = None
     max_debond_cuts: int = 4
+    # False: the thesis's procedure (MODEL.md §9: evaluate once per converged step, no
+    # re-equilibration): releases act from the next load step on
+    reequilibrate: bool = True
 
 
 @dataclass
@@ -203,12 +206,12 @@ class InterfaceController:
             new_any = True
         if new_any:
             problem.rebuild_constraints()
-            self.resolves += 1
+            self.resolves += int(self.settings.reequilibrate)
         self.sync(problem)
         if self.resolves > self.settings.max_resolves:
             raise RuntimeError(f"more than {self.settings.max_resolves} re-solutions at load factor {lam:.6g}; "
                                "the debonding does not stabilise (unstable delamination)")
-        return new_any
+        return new_any and self.settings.reequilibrate
 
     # ------------------------------------------------------------------ restart
     #: the friction state of a contact block (the history of an :class:`InterfaceRun` is every
