@@ -59,29 +59,40 @@ def test_unknown_backend_is_rejected():
         linear.backend_name("umfpack")
 
 
+def _laplacian_3d(n: int) -> sp.csr_matrix:
+    T = sp.diags([-1.0, 2.0, -1.0], [-1, 0, 1], shape=(n, n))
+    eye = sp.eye(n)
+    return (sp.kron(sp.kron(T, eye), eye) + sp.kron(sp.kron(eye, T), eye) + sp.kron(sp.kron(eye, eye), T)).tocsr()
+
+
 @pytest.mark.skipif("pardiso" not in BACKENDS, reason="pypardiso/MKL not available")
-def test_pardiso_parameters_take_effect_and_auto_ordering_takes_the_cheaper():
+@pytest.mark.parametrize("case", ["shell-like 2D", "3D grid"])
+def test_pardiso_parameters_take_effect_and_auto_ordering_takes_the_cheaper(case):
     """PARDISO is called with its parameters applied (iparm[0] = 1): the two orderings give
-    different factors, "auto" keeps the one with fewer flops (and the solution is the same),
+    different factors, "auto" keeps the one with fewer flops (then the smaller factor) - minimum
+    degree for a 3-DOF-per-node 2D pattern, METIS for a 3D grid - and the solution is the same;
     refinement runs only after perturbed pivots, and indices are zero-based."""
-    # a 3-DOF-per-node shell-like pattern, where the orderings differ
-    K = sp.kron(_laplacian_2d(14, 0.5), np.ones((3, 3)) + 3 * np.eye(3)).tocsr()
+    K = (sp.kron(_laplacian_2d(14, 0.5), np.ones((3, 3)) + 3 * np.eye(3)).tocsr() if case == "shell-like 2D"
+         else _laplacian_3d(8))
     r = np.random.default_rng(1).normal(size=K.shape[0])
     stats = {}
     for name in ("metis", "mmd"):
         s = linear.PardisoSymmetric(ordering=name)
         x = s.solve(K, r)
         assert np.allclose(K @ x, r, rtol=1e-9, atol=1e-9 * np.abs(r).max())
-        stats[name] = (int(s._s.iparm[17]), int(s._s.iparm[18]))
+        stats[name] = (int(s._s.iparm[18]), int(s._s.iparm[17]))  # MFLOP, factor nonzeros
         ip = s._s.iparm
         assert ip[0] == 1 and ip[34] == 1 and ip[7] == 0 and ip[1] == linear.ORDERINGS[name]
         s.release()
     assert stats["metis"] != stats["mmd"]  # the ordering parameter reached PARDISO
+    best = min(stats, key=stats.get)
+    assert best == ("mmd" if case == "shell-like 2D" else "metis")
     auto = linear.PardisoSymmetric()
     x = auto.solve(K, r)
-    best = min(stats, key=lambda k: stats[k][1])
-    assert auto._s.iparm[1] == linear.ORDERINGS[best]
+    assert auto._s.iparm[1] == linear.ORDERINGS[best] and int(auto._s.iparm[17]) == stats[best][1]
     assert np.allclose(K @ x, r, rtol=1e-9, atol=1e-9 * np.abs(r).max())
+    x2 = auto.solve(K, 2 * r)  # same pattern: the chosen analysis is reused
+    assert not auto.info.analysed and np.allclose(x2, 2 * x)
     with pytest.raises(ValueError, match="ordering"):
         linear.PardisoSymmetric(ordering="amd")
 

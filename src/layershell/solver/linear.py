@@ -115,7 +115,8 @@ class PardisoSymmetric:
     degree fills less than METIS up to about 2·10⁴ DOFs (pull-off 335 against 452 MFLOP per
     factorisation, 22 473-DOF plate 5.3 against 7.0 GFLOP) and more above (88 k DOFs: 64.6
     against 52.6 GFLOP), so the first pattern up to ``AUTO_ORDERING_MAX_DOFS`` is analysed with
-    both and the cheaper one kept for every later pattern (``benchmarks/solvers.py``)."""
+    both and the cheaper one (fewer flops, then the smaller factor) kept for every later pattern
+    (``benchmarks/solvers.py``); where that is the one analysed last, its analysis is used as it is."""
 
     MTYPE = -2
 
@@ -220,12 +221,17 @@ class PardisoSymmetric:
                 self._ordering = ORDERINGS["metis"]
             else:
                 flops = {}
-                for name, code in ORDERINGS.items():
+                codes = list(ORDERINGS.values())
+                for code in codes:
+                    if flops:
+                        self._free()
                     ip[1] = code
                     self._raw(A, 11, b)
-                    flops[code] = int(ip[18])
-                    self._free()
+                    flops[code] = (int(ip[18]), int(ip[17]))  # MFLOP, then factor size on a tie
                 self._ordering = min(flops, key=flops.get)
+                if self._ordering == codes[-1]:
+                    return  # the analysis in place is the chosen one
+                self._free()
         ip[1] = self._ordering
         self._raw(A, 11, b)
 
