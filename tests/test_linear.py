@@ -108,3 +108,30 @@ def test_unsymmetric_matrix_takes_the_general_path(backend):
     assert np.allclose(x, np.linalg.solve(K.toarray(), r), rtol=1e-9, atol=1e-12)
     if backend == "pardiso":
         assert list(s._pardiso) == [False]  # general mode (mtype 11) only
+
+
+@pytest.mark.skipif("pardiso" not in BACKENDS, reason="pypardiso/MKL not available")
+def test_ordering_choice_is_shared_by_pattern(monkeypatch):
+    """Solvers sharing a decision table (one problem's, started afresh every load step) compare
+    the orderings once per pattern: a new solver on a known pattern analyses only once, with the
+    same choice; a new pattern is compared again."""
+    analyses = []
+    raw = linear.PardisoSymmetric._raw
+
+    def counting(self, A, phase, b):
+        if phase == 11:
+            analyses.append(int(self._s.iparm[1]))
+        return raw(self, A, phase, b)
+
+    monkeypatch.setattr(linear.PardisoSymmetric, "_raw", counting)
+    decisions: dict = {}
+    K = _laplacian_3d(8)
+    r = np.ones(K.shape[0])
+    x1 = linear.LinearSolver("pardiso", decisions=decisions).solve(K, r)
+    assert len(analyses) == 3 and len(decisions) == 1  # METIS, minimum degree, then the choice (METIS)
+    analyses.clear()
+    x2 = linear.LinearSolver("pardiso", decisions=decisions).solve(K, r)
+    assert analyses == [linear.ORDERINGS["metis"]] and np.array_equal(x1, x2)
+    analyses.clear()
+    linear.LinearSolver("pardiso", decisions=decisions).solve(_laplacian_3d(7), np.ones(343))
+    assert len(analyses) >= 2 and len(decisions) == 2

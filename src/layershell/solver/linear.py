@@ -23,6 +23,7 @@ the 5 099-DOF pull-off tangent in 0.024 s (minimum-degree ordering; 0.034 s with
 from __future__ import annotations
 
 import ctypes
+import zlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -120,7 +121,7 @@ class PardisoSymmetric:
 
     MTYPE = -2
 
-    def __init__(self, ordering: str = "auto") -> None:
+    def __init__(self, ordering: str = "auto", decisions: dict | None = None) -> None:
         import pypardiso
 
         backend_name("pardiso")
@@ -130,6 +131,9 @@ class PardisoSymmetric:
         self._init_parameters()
         self.ordering = ordering
         self._ordering: int | None = None if ordering == "auto" else ORDERINGS[ordering]
+        # "auto" choices by pattern, shared by the solvers of one problem: the choice follows from
+        # the pattern alone, so a solver started afresh (every load step) need not compare again
+        self._decisions = decisions
         self._indptr: np.ndarray | None = None
         self._indices: np.ndarray | None = None
         self.info = FactorInfo("pardiso")
@@ -217,8 +221,11 @@ class PardisoSymmetric:
     def _analyse(self, A: sp.csr_matrix, b: np.ndarray) -> None:
         ip = self._s.iparm
         if self._ordering is None:  # "auto": the first pattern decides
+            key = _pattern_key(A, self.MTYPE) if self._decisions is not None else None
             if A.shape[0] > AUTO_ORDERING_MAX_DOFS:
                 self._ordering = ORDERINGS["metis"]
+            elif key is not None and key in self._decisions:
+                self._ordering = self._decisions[key]
             else:
                 flops = {}
                 codes = list(ORDERINGS.values())
@@ -229,6 +236,8 @@ class PardisoSymmetric:
                     self._raw(A, 11, b)
                     flops[code] = (int(ip[18]), int(ip[17]))  # MFLOP, then factor size on a tie
                 self._ordering = min(flops, key=flops.get)
+                if key is not None:
+                    self._decisions[key] = self._ordering
                 if self._ordering == codes[-1]:
                     return  # the analysis in place is the chosen one
                 self._free()
@@ -273,6 +282,11 @@ class PardisoSymmetric:
         self._indptr = None
 
 
+def _pattern_key(A: sp.csr_matrix, mtype: int) -> tuple:
+    """Identifies a sparsity pattern (CRC-32 of the index arrays; about 1 ms per million entries)."""
+    return (mtype, A.shape[0], A.nnz, zlib.crc32(A.indptr.view(np.uint8)), zlib.crc32(A.indices.view(np.uint8)))
+
+
 class PardisoGeneral(PardisoSymmetric):
     """MKL PARDISO for a general real matrix (mtype = 11): the tangent with friction is not
     symmetric (the regularised slip law couples normal pressure and tangential traction)."""
@@ -289,10 +303,11 @@ class LinearSolver:
     """Solves K x = r for the symmetric reduced tangent K with the chosen backend; one instance
     per problem keeps PARDISO's symbolic analysis between calls."""
 
-    def __init__(self, backend: str = "auto", symmetric: bool = True) -> None:
+    def __init__(self, backend: str = "auto", symmetric: bool = True, decisions: dict | None = None) -> None:
         self.backend = backend_name(backend)
         self.symmetric = symmetric  # use PARDISO's symmetric mode when K is symmetric
         self._pardiso: dict[bool, PardisoSymmetric] = {}
+        self._decisions = decisions  # PARDISO's ordering choices by pattern (see PardisoSymmetric)
         self.info = FactorInfo(self.backend)
 
     def solve(self, K: sp.spmatrix, r: np.ndarray) -> np.ndarray:
@@ -301,7 +316,8 @@ class LinearSolver:
         if self.backend == "pardiso":
             sym = self.symmetric and is_symmetric(K)
             if sym not in self._pardiso:
-                self._pardiso[sym] = PardisoSymmetric() if sym else PardisoGeneral()
+                cls = PardisoSymmetric if sym else PardisoGeneral
+                self._pardiso[sym] = cls(decisions=self._decisions)
             x = self._pardiso[sym].solve(K, r)
             self.info = self._pardiso[sym].info
         else:

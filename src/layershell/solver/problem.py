@@ -25,6 +25,8 @@ class Problem:
     extra_blocks: list = field(default_factory=list)
     interfaces: object = None  # InterfaceController when the model has interface laws
     solvers: dict = field(default_factory=dict, repr=False)  # backend -> LinearSolver
+    # PARDISO's ordering choice per sparsity pattern, kept when the solvers are started afresh
+    orderings: dict = field(default_factory=dict, repr=False)
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
@@ -52,7 +54,7 @@ class Problem:
         if backend not in self.solvers:
             # PARDISO's symmetric mode wherever K_r is symmetric (checked per call); friction
             # tangents that are not fall back to the general mode
-            self.solvers[backend] = LinearSolver(backend, symmetric=True)
+            self.solvers[backend] = LinearSolver(backend, symmetric=True, decisions=self.orderings)
         return self.solvers[backend]
 
     def snapshot(self) -> dict:
