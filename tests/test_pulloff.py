@@ -71,10 +71,9 @@ def _interface_points(problem) -> tuple[np.ndarray, object]:
     return X, blk
 
 
-@pytest.fixture(scope="module")
-def pulloff():
-    """Run the example once; keep the released interface points of every converged step."""
-    spec = load(EXAMPLE)
+def run_with_released_points(spec, out) -> tuple:
+    """Run ``spec``; return the result and, per converged step, the released interface points
+    (a boolean array (e, q), a copy)."""
     captured: list = []
     released: list[np.ndarray] = []
     original = Problem.build.__func__
@@ -89,7 +88,14 @@ def pulloff():
 
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(Problem, "build", classmethod(spy))
-        res = run(spec, OUT, progress=progress, write_vtu=False)
+        res = run(spec, out, progress=progress, write_vtu=False)
+    return res, released
+
+
+@pytest.fixture(scope="module")
+def pulloff():
+    """Run the example once; keep the released interface points of every converged step."""
+    res, released = run_with_released_points(load(EXAMPLE), OUT)
     rows = write_force_debonded_length(res.summary, OUT / "force_debonded_length.csv")
     return res, released, rows
 
@@ -203,27 +209,15 @@ def test_pulloff_with_the_thesis_procedure_front_lags_as_in_the_thesis(pulloff):
     ``test_pulloff_debonded_area_grows``)."""
     text = EXAMPLE.read_text().replace("max_bisections = 8", "max_bisections = 8\n\n[delamination]\nreequilibrate = false")
     spec = build(parse(text, str(EXAMPLE)), EXAMPLE.parent)
-    captured: list = []
-    fronts: list[tuple[float, float]] = []
-    original = Problem.build.__func__
-
-    def spy(cls, model):
-        pb = original(cls, model)
-        captured.append(pb)
-        return pb
+    res, released = run_with_released_points(spec, None)
+    X, _ = _interface_points(res.problem)
 
     def front(P, y0, y1):
         sel = (P[:, 1] >= y0) & (P[:, 1] < y1)
         return float(P[sel, 0].max()) if sel.any() else 0.0
 
-    def progress(step, n, lam):
-        blk = captured[-1].interfaces.runs[0].block
-        P = blk.X0[blk.released]
-        fronts.append((front(P, 0.0, HALF_WIDTH / 4), front(P, 3 * HALF_WIDTH / 4, HALF_WIDTH + 1e-9)))
-
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(Problem, "build", classmethod(spy))
-        res = run(spec, None, progress=progress, write_vtu=False)
+    fronts = [(front(X[rel], 0.0, HALF_WIDTH / 4), front(X[rel], 3 * HALF_WIDTH / 4, HALF_WIDTH + 1e-9))
+              for rel in released]
     assert res.converged, res.message
     assert all(s["resolves"] == 0 for s in res.summary["steps"])
     assert res.summary["first_delamination_load_factor"] == pulloff[0].summary["first_delamination_load_factor"]
