@@ -111,21 +111,17 @@ class ContactBlock:
         off = model.offset(itf.upper)[conn]
         _, _, detG = shell_basis(sp, sp.interpolate(off)[..., None])
         ne, nq = len(el), len(wq)
-        m = 27 + 27 * (d + 1)
-        C = np.zeros((ne, nq, 3, m))
-        eye = np.eye(3)
-        up = np.einsum("qn,ij->qinj", sp.N, eye).reshape(nq, 3, 27)
-        C[:, :, :, :27] = up[None]
-        lo_c = -np.einsum("qn,enl,ij->eqinlj", sp.N, H[..., None] ** np.arange(d + 1), eye)
-        C[:, :, :, 27:] = lo_c.reshape(ne, nq, 3, -1)
+        # c: the weights of the upper layer's u_0 (N_n) and of the lower layer's directors at its
+        # top face (-N_n H_n^l) in Δu; C = c ⊗ I₃ (4.43)-(4.44)
+        c = np.ascontiguousarray(np.concatenate(
+            [np.broadcast_to(sp.N, (ne, nq, 9)),
+             -np.einsum("qn,enl->eqnl", sp.N, H[..., None] ** np.arange(d + 1)).reshape(ne, nq, -1)], axis=2))
+        C = np.einsum("eqk,ij->eqikj", c, np.eye(3)).reshape(ne, nq, 3, -1)
         b = np.einsum("eqi,eqim->eqm", sp.A3, C)
         dofs = np.concatenate([dm.layer_dofs[itf.upper][conn][:, :, 0, :].reshape(ne, -1),
                                dm.layer_dofs[itf.lower][conn].reshape(ne, -1)], axis=1)
-        c = np.concatenate([np.broadcast_to(sp.N, (ne, nq, 9)),
-                            -np.einsum("qn,enl->eqnl", sp.N, H[..., None] ** np.arange(d + 1)).reshape(ne, nq, -1)],
-                           axis=2)
         return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(), alpha,
-                   np.zeros((ne, nq), bool), X0=sp.X0, c=np.ascontiguousarray(c))
+                   np.zeros((ne, nq), bool), X0=sp.X0, c=c)
 
     # ------------------------------------------------------------------ kinematics
     def relative_displacement(self, u_full: np.ndarray) -> np.ndarray:

@@ -129,7 +129,6 @@ class PardisoSymmetric:
             raise ValueError(f"unknown PARDISO ordering {ordering!r}; use auto, {', '.join(ORDERINGS)}")
         self._s = pypardiso.PyPardisoSolver(mtype=self.MTYPE)
         self._init_parameters()
-        self.ordering = ordering
         self._ordering: int | None = None if ordering == "auto" else ORDERINGS[ordering]
         # "auto" choices by pattern, shared by the solvers of one problem: the choice follows from
         # the pattern alone, so a solver started afresh (every load step) need not compare again
@@ -221,7 +220,8 @@ class PardisoSymmetric:
     def _analyse(self, A: sp.csr_matrix, b: np.ndarray) -> None:
         ip = self._s.iparm
         if self._ordering is None:  # "auto": the first pattern decides
-            key = _pattern_key(A, self.MTYPE) if self._decisions is not None else None
+            key = (_pattern_key(A, self.MTYPE)
+                   if self._decisions is not None and A.shape[0] <= AUTO_ORDERING_MAX_DOFS else None)
             if A.shape[0] > AUTO_ORDERING_MAX_DOFS:
                 self._ordering = ORDERINGS["metis"]
             elif key is not None and key in self._decisions:
@@ -263,7 +263,7 @@ class PardisoSymmetric:
                 self._analyse(A, b)  # symbolic analysis (ordering)
                 self._indptr, self._indices = A.indptr.copy(), A.indices.copy()
             self._raw(A, 22, b)  # numerical factorisation
-            x = self._raw(A, 33, b)  # solve with iterative refinement
+            x = self._raw(A, 33, b)  # solve (iterative refinement after perturbed pivots)
         except PyPardisoError as exc:
             if self._indptr is not None:
                 try:
