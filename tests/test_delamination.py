@@ -1,4 +1,6 @@
 """Delamination and contact through the whole pipeline (MODEL.md §9-§10, issue 4)."""
+import re
+
 import numpy as np
 import pytest
 from helpers import EXAMPLES, run_example
@@ -116,6 +118,113 @@ def test_cantilever_plate_friction_laws():
     assert p["weak"] >= p["strong"] >= p["bonded"] and p["slip"] > p["strong"]
     for v in ("strong", "slip", "weak"):
         assert 0.42 <= w[v].summary["first_delamination_load_factor"] <= 0.58
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("front", [1.0, 1.5])
+def test_weak_case_reaches_the_thesis_deflection_once_its_zone_reaches_mid_plate(front):
+    """Thesis §5.1 (a): the weak-friction deflection 6.639 cm goes with a zone "evenly up to
+    mid-plate" (Fig. 5.3a). On the 3 × 3 mesh the stress criterion stops this model's zone after
+    the first cascade (2.5 m², the mid-side node row y = 0.5 still bonded and anchoring the
+    layer; test above). Given the thesis's zone instead (the node rows up to y = 1.0 or 1.5
+    debonded from the start, the rendering of Fig. 5.3a lies between them), the same contact and
+    friction model gives the thesis's deflection within the issue's 8 % (measured 0.06540 and
+    0.06684 m, -1.5 % and +0.7 %). So the missing 12 % of the weak case is the zone extent, not
+    the post-fracture mechanics. Also measured: the debonded TRC flap, free at the clamp and
+    weightless, stays straight and lifts off the curved plate (gap 10 / 16 mm at y = 0.11 for the
+    1.0 / 1.5 m zone; the thesis's Fig. 5.3c shows it lying on), so friction does not act there
+    and the three laws come close (1.5 m zone: slip 0.06684, strong 0.06399 m): the thesis's
+    strong case (5.368 cm) needs friction in a zone that this model opens."""
+    zone = f'initially_debonded = [{{ where = "y < {front + 0.01}" }}]\n\n[steps]'
+    res = run_example("cantilever_plate_weak", {"[steps]": zone})
+    assert res.converged
+    w = res.summary["probes"]["w_front_max"]
+    assert abs(w / 0.06639 - 1) < 0.08
+    # the prescribed zone is the debonded area at the end: the node regions up to the front
+    area = res.summary["debonded_area"][-1]["concrete/trc"]
+    assert area > 3.0 * front
+    run = res.problem.interfaces.runs[0]
+    X, gap = run.block.X0.reshape(-1, 3), run.gap.ravel()
+    clamp_row = np.isclose(X[:, 1], 0.5 - 0.5 * np.sqrt(0.6))
+    assert gap[clamp_row].min() > 0.1 * 0.01  # open beyond the contact tolerance: no friction there
+
+
+def test_open_gap_from_the_model_file_decides_where_friction_acts():
+    """``[[interfaces]] open_gap``: a debonded point whose gap exceeds it transmits no friction.
+    The §5.1 strong case with its first metre debonded from the start: with the default
+    (0.1 × 10 mm) the TRC flap lifts off at the clamp and friction stops there; with 1 m no
+    gap counts as open, the flap keeps μ0 τ_max = 1149.5 kN/m² (τ_Delam at zero pressure) and
+    follows the plate more closely, so the plate is stiffer. A non-positive value is refused
+    with a message naming the field."""
+    from layershell.io.build import InputError, build, parse
+
+    repl = {"[steps]": 'initially_debonded = [{ where = "y < 1.01" }]\n\n[steps]', "n = 24": "factors = [0.25, 0.5]"}
+    res = {og: run_example("cantilever_plate_strong", {**repl, "p = 2.0": f"p = 2.0\nopen_gap = {og}"} if og else repl)
+           for og in (None, 1.0)}
+    clamp = {}
+    for og, r in res.items():
+        run = r.problem.interfaces.runs[0]
+        row = np.isclose(run.block.X0.reshape(-1, 3)[:, 1], 0.5 - 0.5 * np.sqrt(0.6))
+        clamp[og] = run.gap.ravel()[row], run.block.cap.ravel()[row]
+    gap, cap = clamp[None]
+    assert gap.min() > 1e-3 and np.all(cap == 0)
+    gap, cap = clamp[1.0]
+    assert np.allclose(cap, 0.95 * 1210.0)
+    assert res[1.0].summary["probes"]["w_front_max"] < 0.9 * res[None].summary["probes"]["w_front_max"]
+    text = (EXAMPLES / "cantilever_plate_strong.toml").read_text().replace("p = 2.0", "p = 2.0\nopen_gap = -1.0")
+    with pytest.raises(InputError, match=r"interfaces\[0\]\.open_gap"):
+        build(parse(text, "x.toml"))
+
+
+_AREA_PROBES = '''[[probes]]
+name = "area"
+quantity = "debonded_area"
+layer = "trc"
+
+[[probes]]
+name = "area_clamp_row"
+quantity = "debonded_area"
+layer = "trc"
+where = "y < 0.8"
+scale = 0.3333333333333333
+
+[[probes]]
+name = "load"
+quantity = "load_factor"
+scale = 48.0
+
+[[probes]]'''
+
+
+def test_debonded_area_and_load_factor_probes():
+    """Probes of the delamination state, per step in probes.csv: at λ = 0.6 the §5.1 plate's zone
+    is the regions of the node rows y = 0 and y = 1 (2.5 m², the first cascade). The whole
+    interface's probe equals summary.json's debonded area; below y = 0.8 only the Gauss row
+    y = 0.113 of the clamp elements counts: width 3 m × its weight 5/18 m, here divided by the
+    3 m width (scale) into a debonded length. The load_factor probe is λ × scale."""
+    res = run_example("cantilever_plate_slip", {"[[probes]]": _AREA_PROBES, "n = 24": "factors = [0.5, 0.6]"})
+    first, last = (s["probes"] for s in res.summary["steps"])
+    assert first["area"] == first["area_clamp_row"] == 0.0
+    assert last["area"] == pytest.approx(res.summary["debonded_area"][-1]["concrete/trc"]) == pytest.approx(2.5)
+    assert last["area_clamp_row"] == pytest.approx(5 / 18)
+    assert (first["load"], last["load"]) == pytest.approx((24.0, 28.8))
+
+
+@pytest.mark.parametrize("probe, message", [
+    ('quantity = "debonded_area"', "needs the layer above the interface"),
+    ('quantity = "debonded_area"\nlayer = "concrete"', "has no [[interfaces]] entry"),
+    ('quantity = "debonded_area"\nlayer = "trc"\nwhere = "y > 5"', "selects no point"),
+    ('quantity = "load_factor"\ncomponent = "z"', "takes no 'component'"),
+    ('quantity = "stress"\npoint = [1, 1, 0]', "needs a component"),
+])
+def test_state_probe_input_errors(probe, message):
+    from layershell.io.build import InputError, build, parse
+
+    text = (EXAMPLES / "cantilever_plate_slip.toml").read_text().replace(
+        "[[probes]]", f'[[probes]]\nname = "bad"\n{probe}\n\n[[probes]]')
+    with pytest.raises(InputError, match=re.escape(message)) as err:
+        build(parse(text, "x.toml"))
+    assert "probes[0]" in str(err.value)
 
 
 @pytest.mark.slow

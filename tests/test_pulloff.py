@@ -41,14 +41,16 @@ ONSET_BAND = (10.7 / F_FULL_KN, 15.9 / F_FULL_KN)
 def force_debonded_length_rows(summary: dict, interface: str = INTERFACE) -> list[dict]:
     """One row per converged step: load factor, pull force F (kN, full specimen), debonded area
     of the half model (mm², released interface regions, initially unbonded zone included),
-    mean debonded length = area / half strap width (mm), and the front: the largest x of the
-    released interface points (mm; the bond zone starts at x = 120)."""
+    mean debonded length = area / half strap width (mm), the front: the largest x of the
+    released interface points (mm; the bond zone starts at x = 120), and the thesis's d
+    (Fig. 5.8a: the bond zone's debonded length over the inner two strap elements; the
+    example's probe ``d_bond_zone``)."""
     rows = []
     for st in summary["steps"]:
         ext = st["debonded_extent"][interface]
         rows.append({"load_factor": st["load_factor"], "force_kN": st["load_factor"] * F_FULL_KN,
                      "debonded_area_mm2": ext["area"], "debonded_length_mm": ext["area"] / HALF_WIDTH,
-                     "front_x_mm": ext["x_max"]})
+                     "front_x_mm": ext["x_max"], "d_bond_zone_mm": st["probes"]["d_bond_zone"]})
     return rows
 
 
@@ -57,10 +59,11 @@ def write_force_debonded_length(summary: dict, path: Path) -> list[dict]:
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh)
-        w.writerow(["load_factor", "force_kN", "debonded_area_mm2", "debonded_length_mm", "front_x_mm"])
+        w.writerow(["load_factor", "force_kN", "debonded_area_mm2", "debonded_length_mm", "front_x_mm",
+                    "d_bond_zone_mm"])
         for r in rows:
             w.writerow([f"{r['load_factor']:.4g}", f"{r['force_kN']:.4g}", f"{r['debonded_area_mm2']:.6g}",
-                        f"{r['debonded_length_mm']:.5g}", f"{r['front_x_mm']:.5g}"])
+                        f"{r['debonded_length_mm']:.5g}", f"{r['front_x_mm']:.5g}", f"{r['d_bond_zone_mm']:.5g}"])
     return rows
 
 
@@ -113,6 +116,25 @@ def test_pulloff_converges(pulloff):
         assert float(row[f"{INTERFACE}:area"]) == pytest.approx(r["debonded_area_mm2"], rel=1e-9)
         assert float(row[f"{INTERFACE}:x_max"]) == pytest.approx(r["front_x_mm"], rel=1e-9)
     assert json.loads((OUT / "summary.json").read_text())["converged"]
+
+
+@pytest.mark.slow
+def test_force_and_debonded_length_probes(pulloff):
+    """The example's probes are the thesis's Fig. 5.8a table: force_kN = λ × 30 and d_bond_zone =
+    the released area of the bond zone (x > 120) under the inner two strap elements (y < 25),
+    divided by their 25 mm width, recomputed here from the released Gauss points and the Gauss
+    weights of the 30 × 12.5 mm elements. d grows from 0 to the whole bond length (150 mm)."""
+    res, released, _ = pulloff
+    X, _ = _interface_points(res.problem)
+    w = gauss_2d(3)[1] * (ELEMENT_LENGTH / 2) * (HALF_WIDTH / 4 / 2)
+    inner_bond = (X[..., 0] > X_EDGE45) & (X[..., 1] < HALF_WIDTH / 2)
+    d = [float((w * (rel & inner_bond)).sum()) / (HALF_WIDTH / 2) for rel in released]
+    steps = res.summary["steps"]
+    assert [s["probes"]["force_kN"] for s in steps] == pytest.approx([s["load_factor"] * F_FULL_KN for s in steps])
+    assert [s["probes"]["d_bond_zone"] for s in steps] == pytest.approx(d, rel=1e-12, abs=1e-12)
+    assert d[0] == 0 and d[-1] == pytest.approx(BOND_END - X_EDGE45) and np.all(np.diff(d) >= 0)
+    table = list(csv.DictReader(open(OUT / "probes.csv")))
+    assert [float(r["d_bond_zone"]) for r in table] == pytest.approx(d, rel=1e-9, abs=1e-9)
 
 
 def predicted_onset(lam0: float = 0.05) -> float:

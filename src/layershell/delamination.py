@@ -48,6 +48,8 @@ class InterfaceLaw:
             bad.append(f"gT_mu = {self.gT_mu} must be positive (use inf for constant friction)")
         if not self.mu_coulomb >= 0:
             bad.append(f"mu_coulomb = {self.mu_coulomb} must not be negative")
+        if self.open_gap is not None and not self.open_gap > 0:
+            bad.append(f"open_gap = {self.open_gap} must be positive (leave it out for 0.1 × the layer thickness)")
         if bad:
             raise ValueError(f"{name}: " + "; ".join(bad))
 

@@ -272,7 +272,8 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u
-                vals = {p.name: p.value(model, problem.dm, u) for p in spec.probes}
+                vals = {p.name: p.value(model, problem.dm, u, st.load_factor, problem.interfaces)
+                        for p in spec.probes}
                 rec = {"step": st.step, "load_factor": st.load_factor, "iterations": st.iterations,
                        "bisections": st.bisections, "wall_seconds": round(st.wall_seconds, 4), "probes": vals}
                 from .interfaces import traction_summary

@@ -12,7 +12,7 @@ import math
 import re
 import tomllib
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from types import UnionType
 from typing import Annotated, Union, get_args, get_origin
@@ -478,7 +478,7 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             raise InputError(f"'{f}.layer': the interface below '{idf.layer}' is defined twice")
         gT = float("inf") if idf.gT_mu == "inf" else float(idf.gT_mu)
         law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
-                           idf.alpha_N, idf.alpha_T)
+                           idf.alpha_N, idf.alpha_T, idf.open_gap)
         try:
             law.check(f)
         except ValueError as exc:
@@ -500,8 +500,8 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             nodes.append(sel)
             if any(v is not None for v in (z.mu0, z.mu, z.gT_mu)):
                 gz = gT if z.gT_mu is None else (float("inf") if z.gT_mu == "inf" else float(z.gT_mu))
-                zone_law = InterfaceLaw(law.sigma_max, law.tau_max, law.p, law.mu0 if z.mu0 is None else z.mu0,
-                                        law.mu if z.mu is None else z.mu, gz, law.mu_coulomb, law.alpha_N, law.alpha_T)
+                zone_law = replace(law, mu0=law.mu0 if z.mu0 is None else z.mu0,
+                                  mu=law.mu if z.mu is None else z.mu, gT_mu=gz)
         if nodes:
             model.initially_debonded[k] = np.unique(np.concatenate(nodes))
             if zone_law is not None:

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
@@ -30,6 +31,7 @@ class Probe:
     local_theta: bool
     reduce: str
     scale: float
+    where: Callable | None = None  # debonded_area: selection of interface points (x, y, z)
 
     def points(self, model, dm, u) -> PointState:
         layers = None if self.layer is None else np.full(self.elements.size, self.layer)
@@ -55,7 +57,26 @@ class Probe:
                 vals = np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
         return self.scale * vals
 
-    def value(self, model, dm, u) -> float:
+    def debonded_area(self, interfaces) -> float:
+        """Released area of the interfaces below ``layer`` (points selected by ``where``)."""
+        area = 0.0
+        for r in interfaces.runs if interfaces is not None else ():
+            blk = r.block
+            if blk.itf.upper != self.layer:
+                continue
+            counted = blk.released
+            if self.where is not None:
+                X = blk.X0
+                counted = counted & np.broadcast_to(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), counted.shape)
+            area += float((blk.w0 * counted).sum())
+        return area
+
+    def value(self, model, dm, u, load_factor: float = 0.0, interfaces=None) -> float:
+        """The probe's value at displacements ``u`` (full vector), load factor and interface states."""
+        if self.quantity == "load_factor":
+            return self.scale * float(load_factor)
+        if self.quantity == "debonded_area":
+            return self.scale * self.debonded_area(interfaces)
         v = self.samples(model, dm, u)
         if self.reduce == "max":
             return float(v.max())
@@ -89,7 +110,12 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
             if pd.layer not in layer_index:
                 raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'; defined: {list(layer_index)}")
             k = layer_index[pd.layer]
+        if pd.quantity in ("debonded_area", "load_factor"):
+            out.append(_global_probe(pd, f, k, model))
+            continue
         comp = pd.component
+        if comp is None:
+            raise InputError(f"'{f}.component': a {pd.quantity} probe needs a component")
         allowed = {"displacement": ("x", "y", "z", "magnitude"),
                    "stress": tuple(STRESS_COMPONENTS) + ("p1", "p2", "p3", "von_mises"),
                    "traction": TRACTION_COMPONENTS}[pd.quantity]
@@ -126,3 +152,40 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         out.append(Probe(pd.name, pd.quantity, comp, pd.measure, el_all, xi_all, eta_all, th_all, k, local,
                          pd.reduce, pd.scale))
     return out
+
+
+def _global_probe(pd, f: str, k: int | None, model) -> Probe:
+    """A probe of the whole state: the load factor, or a debonded area of an interface."""
+    from ..formula import FormulaError
+    from .build import XYZ, InputError, _formula
+
+    unused = {"point": pd.point, "set": pd.set, "component": pd.component}
+    if pd.quantity == "load_factor":
+        unused |= {"layer": pd.layer, "where": pd.where}
+    extra = [key for key, v in unused.items() if v is not None]
+    extra += [key for key, v in (("theta3", pd.theta3 != 0.0), ("reduce", pd.reduce != "none")) if v]
+    if extra:
+        raise InputError(f"'{f}': a {pd.quantity} probe takes no {', '.join(map(repr, extra))}; remove "
+                         + ("them" if len(extra) > 1 else "it"))
+    where = None
+    if pd.quantity == "debonded_area":
+        if k is None:
+            raise InputError(f"'{f}.layer': a debonded_area probe needs the layer above the interface")
+        if k not in model.interface_laws:
+            raise InputError(f"'{f}.layer': the interface below '{pd.layer}' has no [[interfaces]] entry, so it "
+                             "never debonds; add one or name the layer of an [[interfaces]] entry")
+        if pd.where is not None:
+            fm, tol, x = _formula(pd.where, XYZ, f"{f}.where"), 1e-6 * model.mesh.size(), model.mesh.nodes
+            try:
+                any_node = np.any(fm(tol=tol, x=x[:, 0], y=x[:, 1], z=x[:, 2]))
+            except FormulaError as exc:
+                raise InputError(f"'{f}.where': {exc}") from None
+            if not any_node:
+                raise InputError(f"'{f}.where': '{pd.where}' selects no point of the model (use near(x, value) "
+                                 "to compare coordinates with a tolerance)")
+
+            def where(**xyz):
+                return fm(tol=tol, **xyz)
+    empty = np.zeros(0)
+    return Probe(pd.name, pd.quantity, "", pd.measure, empty.astype(np.int64), empty, empty, empty, k, False,
+                 pd.reduce, pd.scale, where)

@@ -314,11 +314,16 @@ class Steps(Strict):
 
 class ProbeDef(Strict):
     name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
-    quantity: Literal["displacement", "stress", "traction"]
+    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor"] = Field(
+        description="debonded_area: released area of the interface below `layer` (within `where`, a formula "
+                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units)")
     point: Vec3 | None = Field(None, description="displacement: nearest node; stress: point on the reference surface")
-    where: str | None = Field(None, description="displacement: node selection (use with reduce)")
+    where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area: "
+                                                "interface points counted")
     set: str | None = None
-    component: str = Field(description="x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises")
+    component: str | None = Field(
+        None, description="displacement: x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises; "
+                          "traction: 13|23|33|shear")
     measure: Literal["cauchy", "pk2"] = "cauchy"
     theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
@@ -374,7 +379,11 @@ class InterfaceDef(Strict):
     gT_mu: Union[PositiveFloat, Literal["inf"]] = Field("inf", description="slip of the residual friction (4.76)")
     mu_coulomb: float = Field(0.0, ge=0, description="Coulomb coefficient of the fallback (4.84)")
     alpha_N: PositiveFloat | None = Field(None, description="normal contact penalty (default 100 E3/H_min)")
-    alpha_T: PositiveFloat | None = Field(None, description="tangential stick penalty (default alpha_N)")
+    alpha_T: PositiveFloat | None = Field(
+        None, description="tangential stick penalty of the regularised friction (default G13/H of the thinner layer)")
+    open_gap: PositiveFloat | None = Field(
+        None, description="a debonded point whose gap exceeds this is open: no friction there (default 0.1 × the "
+                          "upper layer's thickness; an addition, the thesis's friction stops at any opening)")
     initially_debonded: list[InitialZone] = []
 
 
