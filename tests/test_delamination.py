@@ -213,7 +213,7 @@ def test_debonded_area_and_load_factor_probes():
 @pytest.mark.parametrize("probe, message", [
     ('quantity = "debonded_area"', "needs the layer above the interface"),
     ('quantity = "debonded_area"\nlayer = "concrete"', "has no [[interfaces]] entry"),
-    ('quantity = "debonded_area"\nlayer = "trc"\nwhere = "y > 5"', "selects no point"),
+    ('quantity = "debonded_area"\nlayer = "trc"\nwhere = "y > 5"', "selects no node"),
     ('quantity = "load_factor"\ncomponent = "z"', "takes no 'component'"),
     ('quantity = "stress"\npoint = [1, 1, 0]', "needs a component"),
 ])

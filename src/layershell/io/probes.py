@@ -67,7 +67,8 @@ class Probe:
             counted = blk.released
             if self.where is not None:
                 X = blk.X0
-                counted = counted & np.broadcast_to(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), counted.shape)
+                inside = np.asarray(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), bool)
+                counted = counted & np.broadcast_to(inside, counted.shape)
             area += float((blk.w0 * counted).sum())
         return area
 
@@ -111,7 +112,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
                 raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'; defined: {list(layer_index)}")
             k = layer_index[pd.layer]
         if pd.quantity in ("debonded_area", "load_factor"):
-            out.append(_global_probe(pd, f, k, model))
+            out.append(_global_probe(pd, f, k, model, node_selection))
             continue
         comp = pd.component
         if comp is None:
@@ -154,9 +155,8 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
     return out
 
 
-def _global_probe(pd, f: str, k: int | None, model) -> Probe:
+def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     """A probe of the whole state: the load factor, or a debonded area of an interface."""
-    from ..formula import FormulaError
     from .build import XYZ, InputError, _formula
 
     unused = {"point": pd.point, "set": pd.set, "component": pd.component}
@@ -175,14 +175,8 @@ def _global_probe(pd, f: str, k: int | None, model) -> Probe:
             raise InputError(f"'{f}.layer': the interface below '{pd.layer}' has no [[interfaces]] entry, so it "
                              "never debonds; add one or name the layer of an [[interfaces]] entry")
         if pd.where is not None:
-            fm, tol, x = _formula(pd.where, XYZ, f"{f}.where"), 1e-6 * model.mesh.size(), model.mesh.nodes
-            try:
-                any_node = np.any(fm(tol=tol, x=x[:, 0], y=x[:, 1], z=x[:, 2]))
-            except FormulaError as exc:
-                raise InputError(f"'{f}.where': {exc}") from None
-            if not any_node:
-                raise InputError(f"'{f}.where': '{pd.where}' selects no point of the model (use near(x, value) "
-                                 "to compare coordinates with a tolerance)")
+            node_selection(model.mesh, pd, f)  # checks the formula; it must select some part of the model
+            fm, tol = _formula(pd.where, XYZ, f"{f}.where"), 1e-6 * model.mesh.size()
 
             def where(**xyz):
                 return fm(tol=tol, **xyz)
