@@ -9,7 +9,7 @@ from helpers import EXAMPLES
 from layershell.export import reference_displacement
 from layershell.io.build import InputError, build, parse
 from layershell.plots import ZoneHistory, write_figures
-from layershell.runner import run
+from layershell.runner import run, through_thickness
 from layershell.solver.newton import load_steps
 
 #: a 2 × 1 m block of two layers; the top layer is sucked off (σ33 = 1.1 λ) and debonds when σ33
@@ -146,7 +146,7 @@ def test_thickness_figure_at_stress_probes(tmp_path):
     from σ_φ(b) to σ_φ(a), close to Lamé's −1.667 / −2.667 kN/m² (README table)."""
     spec = _spec((EXAMPLES / "ring.toml").read_text())
     res = run(spec, None)
-    info = write_figures(tmp_path, spec, res.problem, res.u, res.summary)
+    info = write_figures(tmp_path, spec, res.problem, res.u, res.summary, through_thickness=through_thickness)
     for n in ("sigma_phi_inner", "sigma_phi_outer", "sigma_r_outer"):
         assert _is_png(tmp_path / f"thickness_{n}.png")
     lo, hi = info["thickness_sigma_phi_inner.png"]["range"]
@@ -177,11 +177,14 @@ def test_zone_history_records_the_debonded_flags():
     from layershell.solver.problem import Problem
 
     pb = Problem.build(spec.model)  # driven like runner.run does
-    zones = ZoneHistory(pb.interfaces)
+    zones = ZoneHistory(pb.interfaces, keep=[1, 2, 3])
+    bounded = ZoneHistory(pb.interfaces)  # no zone_steps: keeps the first debonding and the latest step only
     areas = []
     for st in load_steps(pb, spec.load_factors, spec.newton, on_step_end=pb.interfaces.update):
         zones.record(st.step, st.load_factor)
+        bounded.record(st.step, st.load_factor)
         areas.append(pb.interfaces.debonded_area()["base/top"])
+    assert bounded.steps == [2, 3] and bounded.default_steps() == [2, 3]
     blk = pb.interfaces.runs[0].block
     rec = [float((blk.w0 * r[0]).sum()) for r in zones.released]
     assert rec == pytest.approx(areas)

@@ -302,7 +302,7 @@ def calibrate(model: str | Path, data: str | Path, x: str, y: str, params: list[
         pass
     if best_run:
         spec = build_spec(with_values(doc, best["values"]), model.parent, f"{model} (best)")
-        run(spec, out / "best", write_vtu=False)
+        run(spec, out / "best", write_vtu=False, overwrite=True)
     return result
 
 

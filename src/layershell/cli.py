@@ -2,8 +2,10 @@
 paragraph and exit code 2.
 
 Exit codes: 0 success; 1 the solution failed (no convergence) or an internal error; 2 bad input
-(model file, supports, command-line arguments, a restart folder of another model); 130 stopped by
-Ctrl-C (the converged steps are written; continue with ``--restart``). Set
+(model file, supports, command-line arguments, a restart folder of another model, a results
+folder in use or holding another model's results); 130 stopped by Ctrl-C, 143 by SIGTERM (the
+converged steps are written; continue with ``--restart``). Output to a console that cannot show
+a character (e.g. ``PYTHONIOENCODING=ascii``) replaces it, never fails. Set
 ``LAYERSHELL_TRACEBACK=1`` to see the Python traceback of an unexpected error instead of the
 one-paragraph message.
 """
@@ -23,6 +25,32 @@ app = typer.Typer(add_completion=False, no_args_is_help=True,
                   help="layershell: layered shells that delaminate (multi-director shell FE).")
 err = Console(stderr=True)
 out = Console()
+
+
+def _safe_streams() -> None:
+    """Characters the console cannot encode (λ, —, Θ on an ASCII console) are replaced instead of
+    raising UnicodeEncodeError after the results are written."""
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.reconfigure(errors="replace")
+        except (AttributeError, ValueError, OSError):
+            pass
+
+
+def _version_option(value: bool) -> None:
+    if value:
+        from . import __version__
+
+        _safe_streams()
+        out.print(f"layershell {__version__}", highlight=False)
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(version: bool = typer.Option(False, "--version", callback=_version_option, is_eager=True,
+                                       help="print the version of layershell and exit")) -> None:
+    """layershell: layered shells that delaminate (multi-director shell FE)."""
+    _safe_streams()
 
 
 def _fail(message: str, code: int = 2) -> NoReturn:
@@ -163,19 +191,27 @@ def run(
     out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>, "
                                  "with --restart the folder restarted from)"),
     no_vtu: bool = typer.Option(False, "--no-vtu", help="skip the ParaView files"),
-    quiet: bool = typer.Option(False, "--quiet", "-q"),
+    quiet: bool = typer.Option(False, "--quiet", "-q", help="no progress line and no probe table"),
+    verbose: bool = typer.Option(False, "--verbose", "-v", help="print every line of run.log (each Newton "
+                                 "iteration: residual, energy norm; bond and contact changes) while solving"),
     restart: Path = typer.Option(None, "--restart", help="continue a stopped run from the last converged step "
                                  "saved in this results folder (checkpoint.npz)"),
+    overwrite: bool = typer.Option(False, "--overwrite", help="delete the results of another model in the "
+                                   "results folder (without it such a folder is refused; a rerun of the same "
+                                   "model file replaces its own results anyway)"),
 ):
-    """Solve a model and write summary.json, probes.csv, ParaView files and plots.
+    """Solve a model and write summary.json, probes.csv, run.log, ParaView files and plots.
 
-    Every converged step is written at once (with the restart file checkpoint.npz); Ctrl-C stops
-    cleanly after the converged steps (exit code 130), and ``--restart DIR`` continues from there.
+    Every converged step is recorded at once (with the restart file checkpoint.npz). Ctrl-C or
+    SIGTERM stop cleanly after the converged steps (exit code 130 or 143); --restart DIR continues
+    from there. One run at a time may write into a results folder.
     """
     spec = _load(model)
     from .checkpoint import CheckpointError
     from .constraints import ConstraintError
     from .formula import FormulaError
+    from .recorder import ResultsFolderError
+    from .runner import raise_terminated
     from .runner import run as run_model
 
     if restart is not None and out_dir is None:
@@ -184,16 +220,36 @@ def run(
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     failure: tuple[str, int] | None = None
+    old_term = _install_sigterm(raise_terminated)
     try:
-        with Progress(TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("λ = {task.fields[lam]:.4g}"),
+        with Progress(TextColumn("[bold]{task.description}"), BarColumn(), TextColumn("{task.fields[state]}"),
                       TimeElapsedColumn(), console=err, disable=quiet, transient=False) as prog:
-            task = prog.add_task(escape(model.stem), total=len(spec.load_factors), lam=0.0)
+            task = prog.add_task(escape(model.stem), total=len(spec.load_factors), state="λ = 0")
+            live = {"lam": 0.0}
+
+            def on_step(i, n, lam):
+                live["lam"] = lam
+                prog.update(task, completed=i, state=f"λ = {lam:.4g}")
+
+            def on_iteration(info):
+                state = (f"λ = {live['lam']:.4g} | step {info['step']} → λ {info['load_factor']:.4g}: "
+                         f"iteration {info['iteration']}, residual {info['relative_residual']:.2e}")
+                if info["resolves"]:
+                    state += f", re-solutions {info['resolves']}"
+                if info["debonded_area"]:
+                    state += f", debonded {info['debonded_area']:.4g}"
+                prog.update(task, state=state)
+
+            def echo(line):
+                prog.console.print(escape(line), highlight=False, soft_wrap=True)
+
             try:
                 with warnings.catch_warnings(record=True) as caught:  # numerical warnings: one note below
                     warnings.simplefilter("default")
-                    res = run_model(spec, out_dir, lambda i, n, lam: prog.update(task, completed=i, lam=lam),
-                                    write_vtu=False if no_vtu else None, restart=restart)
-            except CheckpointError as exc:
+                    res = run_model(spec, out_dir, on_step, write_vtu=False if no_vtu else None, restart=restart,
+                                    overwrite=overwrite, monitor=None if quiet else on_iteration,
+                                    echo=echo if verbose else None)
+            except (CheckpointError, ResultsFolderError) as exc:
                 failure = (f"{model}: {exc}", 2)
             except ConstraintError as exc:
                 failure = (f"{model}: 'supports': {exc}", 2)
@@ -201,19 +257,24 @@ def run(
                 failure = (f"{model}: a formula or value in the model file cannot be evaluated ({exc}); "
                            "check the load magnitudes and distributions", 2)
             except OSError as exc:
-                failure = (f"cannot write the results to '{out_dir}': {exc.strerror or exc}; "
-                           "choose another folder with --out", 2)
+                failure = (_os_error_message(exc, out_dir), 2)
             except MemoryError:
                 failure = (f"{model}: the model needs more memory than this computer has; use a coarser mesh, "
                            "fewer layers or fewer directors", 2)
+            except KeyboardInterrupt:
+                raise
             except Exception as exc:
                 if _traceback_wanted():
                     raise
                 failure = (f"{model}: the solution stopped with an internal error ({type(exc).__name__}: {exc}); "
                            "the converged steps are in summary.json; set LAYERSHELL_TRACEBACK=1 to see where, and "
                            "report it with the model file", 1)
-    except KeyboardInterrupt:  # before the first load step (building the problem)
-        failure = (f"{model}: interrupted by the user before the first load step; nothing was solved", 130)
+    except KeyboardInterrupt as exc:  # before the first load step (building the problem)
+        term = type(exc).__name__ == "Terminated"
+        failure = (f"{model}: {'stopped by SIGTERM' if term else 'interrupted by the user'} before the first load "
+                   "step; nothing was solved", 143 if term else 130)
+    finally:
+        _install_sigterm(old_term)
     if failure is not None:
         _fail(*failure)
     numeric = [w for w in caught if issubclass(w.category, RuntimeWarning)]
@@ -229,10 +290,39 @@ def run(
         for k, v in s["probes"].items():
             out.print(f"  {k:24s} = {v: .6g}", highlight=False)
         out.print(f"{s['n_elements']} elements, {s['n_dofs']} DOFs, {len(s['steps'])} step(s), "
-                  f"{s['wall_seconds']:.2f} s — results in {out_dir}/ (summary.json, probes.csv, *.vtu, *.pvd)",
-                  soft_wrap=True, highlight=False)
+                  f"{s['wall_seconds']:.2f} s — results in {out_dir}/ (summary.json, probes.csv, run.log, "
+                  "*.vtu, *.pvd)", soft_wrap=True, highlight=False)
     if not res.converged:
         _report_failure(model, res, out_dir)
+
+
+def _install_sigterm(handler):
+    """Install ``handler`` for SIGTERM (main thread only); returns the previous one (or None)."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "SIGTERM") or threading.current_thread() is not threading.main_thread():
+        return None
+    try:
+        return signal.signal(signal.SIGTERM, handler if handler is not None else signal.SIG_DFL)
+    except (ValueError, OSError):
+        return None
+
+
+def _os_error_message(exc: OSError, out_dir: Path) -> str:
+    """One paragraph for a file that cannot be written (name too long, no space, no permission)."""
+    import errno
+
+    name = getattr(exc, "filename", None) or out_dir
+    if exc.errno == errno.ENAMETOOLONG:
+        return (f"cannot write the results: the path '{name}' is too long for the file system (a file or folder "
+                "name may have at most 255 bytes); choose a shorter folder with --out or a shorter model file name")
+    if exc.errno == errno.ENOSPC:
+        return f"cannot write the results to '{out_dir}': the disk is full; free space or choose another folder with --out"
+    if exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return (f"cannot write the results to '{out_dir}': no permission to write '{name}'; choose a folder you "
+                "may write to with --out")
+    return f"cannot write the results to '{out_dir}': {exc.strerror or exc}; choose another folder with --out"
 
 
 def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
@@ -244,7 +334,8 @@ def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
     if getattr(res, "interrupted", False) or "interrupted" in msg:
         again = (f"; continue with: layershell run {model} --restart {out_dir}" if out_dir is not None
                  and res.summary.get("steps") else "")
-        _fail(f"{model}: {msg}; summary.json and probes.csv in {where} hold them{again}", 130)
+        code = 143 if getattr(res, "signal", None) == "SIGTERM" else 130
+        _fail(f"{model}: {msg}; summary.json and probes.csv in {where} hold them{again}", code)
     kept = (f"the {len(res.summary['steps'])} converged step(s) are kept in summary.json and probes.csv in {where}"
             if res.summary.get("steps") else "no load step converged")
     modes = _rigid_body_modes(res.problem)

@@ -16,7 +16,6 @@ Points are undeformed positions; ParaView's *Warp By Vector* uses the ``displace
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
@@ -256,26 +255,52 @@ def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None):
                        point_data=point_data, cell_data={"element_id": [itf.elements.astype(np.int64)]})
 
 
+_PVD_HEAD = ('<?xml version="1.0"?>\n<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">\n'
+             "  <Collection>\n")
+_PVD_TAIL = "  </Collection>\n</VTKFile>\n"
+
+
+def _pvd_entry(t: float, f: str) -> str:
+    from xml.sax.saxutils import quoteattr
+
+    return f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(str(f))} />\n'
+
+
 def write_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
     """Write a ParaView collection file listing ``(timestep, file)`` pairs (file names relative
     to the ``.pvd``), atomically."""
+    text = _PVD_HEAD + "".join(_pvd_entry(t, f) for t, f in entries) + _PVD_TAIL
+    atomic_write(Path(path), lambda tmp: tmp.write_text(text, encoding="utf-8"))
+
+
+def append_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
+    """Add ``entries`` to a collection file written by :func:`write_pvd` at constant cost: one
+    write at the position of the closing tags (new entries and the closing tags again), so the
+    file is never without its closing tags on disk (the write only extends it). Falls back to
+    rewriting when the file does not end as :func:`write_pvd` leaves it."""
     path = Path(path)
-    root = ET.Element("VTKFile", type="Collection", version="0.1", byte_order="LittleEndian")
-    coll = ET.SubElement(root, "Collection")
-    for t, f in entries:
-        ET.SubElement(coll, "DataSet", timestep=repr(float(t)), group="", part="0", file=str(f))
-    ET.indent(root)
-    text = '<?xml version="1.0"?>\n' + ET.tostring(root, encoding="unicode") + "\n"
-    atomic_write(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    tail = _PVD_TAIL.encode()
+    data = "".join(_pvd_entry(t, f) for t, f in entries).encode("utf-8") + tail
+    fd = os.open(path, os.O_RDWR)
+    try:
+        size = os.fstat(fd).st_size
+        if size >= len(tail) and os.pread(fd, len(tail), size - len(tail)) == tail:
+            os.pwrite(fd, data, size - len(tail))
+            return
+    finally:
+        os.close(fd)
+    raise ValueError(f"{path} does not end with the closing tags of a collection")
 
 
 class PvdWriter:
-    """Keeps the surface and solid series of a run and rewrites ``surface.pvd`` and
-    ``solid.pvd`` in ``out_dir`` after each :meth:`add`."""
+    """Keeps the surface and solid series of a run and updates ``surface.pvd``, ``solid.pvd``
+    (and one ``<key>.pvd`` per further series) in ``out_dir`` after each :meth:`add`: the new
+    entries are appended (:func:`append_pvd`), so a step costs the same however long the run."""
 
     def __init__(self, out_dir: Path):
         self.out_dir = Path(out_dir)
         self.series: dict[str, list[tuple[float, str]]] = {"surface": [], "solid": []}
+        self._on_disk: dict[str, int] = {}  # entries of each series in its file
 
     @property
     def surface(self) -> list[tuple[float, str]]:
@@ -300,7 +325,21 @@ class PvdWriter:
         self.write()
 
     def write(self) -> None:
+        """Bring every series file up to date: append what is new, rewrite what is not known."""
         self.out_dir.mkdir(parents=True, exist_ok=True)
         for key, entries in self.series.items():
-            if entries or key in ("surface", "solid"):
-                write_pvd(self.out_dir / f"{key}.pvd", entries)
+            if not entries and key not in ("surface", "solid"):
+                continue
+            path = self.out_dir / f"{key}.pvd"
+            n = self._on_disk.get(key)
+            if n is not None and n < len(entries):
+                try:
+                    append_pvd(path, entries[n:])
+                    self._on_disk[key] = len(entries)
+                    continue
+                except (OSError, ValueError):
+                    pass
+            elif n == len(entries):
+                continue
+            write_pvd(path, entries)
+            self._on_disk[key] = len(entries)

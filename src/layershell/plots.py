@@ -30,10 +30,13 @@ def _figure(figsize):
 
 
 def _save(fig, path) -> Path:
+    """Write ``fig`` as PNG atomically (temporary file in the same folder, then renamed: a kill
+    never leaves a 0-byte or truncated PNG), mode from the umask."""
+    from .io.output import atomic_write
+
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     try:
-        fig.savefig(path, dpi=_DPI)
+        atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=_DPI, format="png"))
     finally:
         fig.clear()  # "close": release artists; the figure is not registered with pyplot
     return path
@@ -191,22 +194,31 @@ def plot_load_vs_area(path, load_factors, areas: dict[str, list[float]], units: 
 
 
 class ZoneHistory:
-    """Debonded flags of every interface after each converged step, for zone maps at chosen steps.
+    """Debonded flags of every interface after the converged steps that zone maps may show.
 
     Create it with the run's interface controller (or None: then it records nothing) and call
-    :meth:`record` once per converged step. Memory: one bool per face Gauss point and step.
+    :meth:`record` once per converged step. Kept: the steps in ``keep`` (``[output] zone_steps``),
+    the first step with new debonding and the latest step, so memory (one bool per face Gauss
+    point and kept step) and the checkpoint stay bounded however many steps the run has.
     """
 
-    def __init__(self, controller=None):
+    def __init__(self, controller=None, keep=None):
         self.controller = controller
+        self.keep = {int(k) for k in (keep or ())}
         self.initial = [r.block.released.copy() for r in controller.runs] if controller is not None else []
         self.steps: list[int] = []
         self.load_factors: list[float] = []
         self.released: list[list[np.ndarray]] = []
 
+    def _first(self) -> int | None:
+        return next((s for s, rel in zip(self.steps, self.released)
+                     if any(np.any(a & ~b) for a, b in zip(rel, self.initial))), None)
+
     def record(self, step: int, load_factor: float) -> None:
         if self.controller is None:
             return
+        if self.steps and self.steps[-1] not in self.keep and self.steps[-1] != self._first():
+            del self.steps[-1], self.load_factors[-1], self.released[-1]  # only the latest is kept
         self.steps.append(int(step))
         self.load_factors.append(float(load_factor))
         self.released.append([r.block.released.copy() for r in self.controller.runs])
@@ -216,8 +228,7 @@ class ZoneHistory:
         last recorded step."""
         if not self.steps:
             return []
-        first = next((s for s, rel in zip(self.steps, self.released)
-                      if any(np.any(a & ~b) for a, b in zip(rel, self.initial))), None)
+        first = self._first()
         return sorted({s for s in (first, self.steps[-1]) if s is not None})
 
 
@@ -263,7 +274,8 @@ def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_" else "_" for c in name)
 
 
-def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneHistory | None = None) -> dict:
+def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneHistory | None = None,
+                  through_thickness=None) -> dict:
     """All PNG figures of a run, written into ``out`` (called once after the last step).
 
     - ``load_displacement.png`` (every probe) and ``load_displacement_<probe>.png`` (one each):
@@ -275,7 +287,9 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
       ``[output] zone_steps``, default: first debonding and last step) and
       ``load_debonded_area.png``.
 
-    Returns ``{file name: info}`` (info: a dict of the plotted data ranges, for checks).
+    ``through_thickness``: the sampler of the thickness plots (:func:`layershell.runner.through_thickness`;
+    None: no thickness plots). Returns ``{file name: info}`` (info: a dict of the plotted data
+    ranges, for checks).
     """
     out = Path(out)
     model = spec.model
@@ -301,8 +315,8 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
             continue
         from types import SimpleNamespace
 
-        from .runner import through_thickness
-
+        if through_thickness is None:  # the sampler is handed in (runner.through_thickness): no import circle
+            continue
         prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21)
         cols = through_thickness(prof, model, problem.dm, u)
         f = f"thickness_{_safe(pd.name)}.png"

@@ -14,7 +14,7 @@ import numpy as np
 
 from . import checkpoint
 from .io.build import RunSpec
-from .io.output import write_csv, write_json
+from .recorder import Recorder, read_history
 from .solver.newton import ConvergenceError, DebondCut, load_steps
 from .solver.problem import Problem
 
@@ -50,10 +50,8 @@ def through_thickness(spec_profile, model, dm, u):
     return out
 
 
-def write_profiles(spec, problem, u, out: Path) -> dict:
+def write_profiles(spec, problem, u, rec: Recorder) -> dict:
     """profile_<name>.csv (Θ³ and one column per layer) and profile_<name>.png."""
-    from .io.output import write_csv
-
     files = {}
     for pr in spec.profiles:
         cols = through_thickness(pr, spec.model, problem.dm, u)
@@ -63,58 +61,58 @@ def write_profiles(spec, problem, u, out: Path) -> dict:
             th, v = cols[n]
             for t, val in zip(th, v):
                 rows.append([float(t)] + [float(val) if j == i else "" for j in range(len(names))])
-        write_csv(out / f"profile_{pr.name}.csv", ["theta3"] + names, rows)
+        rec.write_csv(f"profile_{pr.name}.csv", ["theta3"] + names, rows)
         files[pr.name] = f"profile_{pr.name}.csv"
         if spec.output.plots:
             from .plots import plot_through_thickness
 
-            plot_through_thickness(out / f"profile_{pr.name}.png", {k: (v, t) for k, (t, v) in cols.items()},
-                                   f"{pr.measure} σ{pr.component}")
+            plot_through_thickness(rec.path(f"profile_{pr.name}.png"),
+                                   {k: (v, t) for k, (t, v) in cols.items()}, f"{pr.measure} σ{pr.component}")
     return files
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM turned into an exception (by the CLI): the run ends like Ctrl-C (exit code 143)."""
+
+
+def raise_terminated(signum, frame) -> None:
+    """SIGTERM handler: stop like Ctrl-C (the converged steps are kept)."""
+    raise Terminated()
 
 
 @contextmanager
 def _sigint_deferred(reraise: bool = True):
-    """Hold Ctrl-C (SIGINT) back while result files and the checkpoint of a step are written, so
-    that they stay consistent; the interrupt is raised afterwards (``reraise``) or dropped (when
-    the run is stopping anyway). Only in the main thread (elsewhere signals cannot be caught)."""
+    """Hold Ctrl-C (SIGINT) and SIGTERM back while result files and the checkpoint of a step are
+    written, so that they stay consistent; the interrupt is raised afterwards (``reraise``) or
+    dropped (when the run is stopping anyway). Only in the main thread (elsewhere signals cannot
+    be caught). SIGTERM is only held when a handler of its own is installed (the CLI's)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     hits: list[int] = []
+    sigs = [signal.SIGINT]
+    if hasattr(signal, "SIGTERM") and signal.getsignal(signal.SIGTERM) not in (signal.SIG_DFL, signal.SIG_IGN, None):
+        sigs.append(signal.SIGTERM)
+    old = {}
     try:
-        old = signal.signal(signal.SIGINT, lambda signum, frame: hits.append(signum))
+        for sg in sigs:
+            old[sg] = signal.signal(sg, lambda signum, frame: hits.append(signum))
     except ValueError:  # not the main interpreter
         yield
         return
     try:
         yield
     finally:
-        signal.signal(signal.SIGINT, old if old is not None else signal.SIG_DFL)
+        for sg, h in old.items():
+            signal.signal(sg, h if h is not None else signal.SIG_DFL)
     if hits and reraise:
-        raise KeyboardInterrupt
+        raise (Terminated if signal.SIGTERM in hits and hasattr(signal, "SIGTERM") else KeyboardInterrupt)
 
 
 def _version() -> str:
     from . import __version__
 
     return __version__
-
-
-def write_delamination_table(path: Path, steps: list[dict]) -> None:
-    """delamination.csv: per converged step the load factor and, per interface, the debonded
-    area and the bounding box of the debonded points (e.g. the front position of a pull-off
-    test is the largest x)."""
-    recs = [s for s in steps if "debonded_extent" in s]
-    if not recs:
-        return
-    names = list(recs[0]["debonded_extent"])
-    keys = ["area", "x_min", "x_max", "y_min", "y_max"]
-    header = ["step", "load_factor"] + [f"{n}:{k}" for n in names for k in keys]
-    rows = [[s["step"], float(s["load_factor"])]
-            + [("" if s["debonded_extent"][n][k] is None else float(s["debonded_extent"][n][k]))
-               for n in names for k in keys] for s in recs]
-    write_csv(path, header, rows)
 
 
 def _fresh_linear_solvers(problem: Problem) -> None:
@@ -157,6 +155,7 @@ class RunResult:
     history: list[dict] = field(default_factory=list)
     interrupted: bool = False
     failure: dict | None = None  # non-convergence: step, load_factor, residual
+    signal: str | None = None  # "SIGINT" or "SIGTERM" when interrupted
 
 
 def _rebase(entries: list, old: Path, new: Path) -> list[tuple[float, str]]:
@@ -166,27 +165,64 @@ def _rebase(entries: list, old: Path, new: Path) -> list[tuple[float, str]]:
     return [(float(t), Path(os.path.relpath((old / p).resolve(), new.resolve())).as_posix()) for t, p in entries]
 
 
+def _history(ck, where) -> tuple[list[dict], dict[str, list]]:
+    """The step records before a restart (with their ParaView files) and, for checkpoints of
+    format 1 written before steps.jsonl existed, the ParaView series stored in the checkpoint."""
+    if "steps" in ck.summary:  # older checkpoint: the history is inside
+        return [dict(r) for r in ck.summary.pop("steps")], {k: list(v) for k, v in ck.pvd.items()}
+    hist = read_history(checkpoint.locate(where).parent, ck.step)
+    if len(hist) != ck.step or [r.get("step") for r in hist] != list(range(1, ck.step + 1)):
+        raise checkpoint.CheckpointError(
+            f"--restart '{where}': steps.jsonl next to the checkpoint holds {len(hist)} of its {ck.step} step "
+            "record(s) (deleted or damaged); rerun the model from the start")
+    return hist, {}
+
+
+_IN_SUMMARY_ONLY = ("files",)
+
+
 def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, float], None] | None = None,
-        write_vtu: bool | None = None, restart: str | Path | None = None) -> RunResult:
-    """Solve ``spec`` and (if ``out``) write summary.json, probes.csv, ParaView files and the
-    restart file checkpoint.npz after every converged step (atomically).
+        write_vtu: bool | None = None, restart: str | Path | None = None, overwrite: bool = False,
+        monitor: Callable[[dict], None] | None = None, echo: Callable[[str], None] | None = None) -> RunResult:
+    """Solve ``spec`` and (if ``out``) record every converged step in the results folder through
+    a :class:`~layershell.recorder.Recorder` (summary.json, probes.csv, steps.jsonl, run.log,
+    ParaView files, the restart file checkpoint.npz; figures at the end).
 
     ``restart``: a results folder (or its checkpoint.npz) of an earlier run of the same model:
     the run continues after its last converged step with the full state (displacements, bond
     flags, interface histories) and gives the same results as an uninterrupted run.
-    Non-convergence and Ctrl-C end the run with ``converged = False`` and the converged steps
-    written; other errors are re-raised after the converged steps are written.
+    ``overwrite``: replace the results of another model in ``out`` (otherwise refused, see the
+    recorder). ``monitor(info)``: called after every Newton iteration with step, iteration,
+    load factor, residual, re-solutions and debonded area; ``echo(line)``: every run.log line.
+    Non-convergence, Ctrl-C and SIGTERM (with the CLI's handler) end the run with ``converged =
+    False`` and the converged steps written; other errors are re-raised after the converged steps
+    are written.
     """
+    ck = checkpoint.load(restart) if restart is not None else None  # a bad folder fails before the build
+    if out is None:
+        return _run(spec, None, progress, write_vtu, restart, ck, monitor)
+    out = Path(out)
+    resume = restart is not None and checkpoint.locate(restart).parent.resolve() == out.resolve()
+    with Recorder(out, model_file=str(Path(spec.path).resolve()) if spec.path is not None else None,
+                  model_hash=checkpoint.model_hash(spec), title=spec.source.model.title,
+                  overwrite=overwrite, resume=resume, echo=echo) as rec:
+        return _run(spec, rec, progress, write_vtu, restart, ck, monitor)
+
+
+def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, monitor) -> RunResult:
     t0 = time.perf_counter()
     model = spec.model
-    ck = checkpoint.load(restart) if restart is not None else None  # a bad folder fails before the build
+    out = rcd.folder if rcd is not None else None
+    log = rcd.log if rcd is not None else (lambda line: None)
     problem = Problem.build(model)
     if ck is not None:
         checkpoint.check_compatible(ck, spec, problem.dm.n_full, restart)
     names = [p.name for p in spec.probes]
+    hash_ = checkpoint.model_hash(spec) if out is not None else ""
     summary = {
         "title": spec.source.model.title,
         "model_file": str(spec.path) if spec.path is not None else None,
+        "model_hash": hash_,
         "version": _version(),
         "units": model.units,
         "converged": False,
@@ -200,16 +236,12 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
         "steps": [],
         "probes": {},
     }
-    rows: list[list] = []
     vtu = spec.output.vtu if write_vtu is None else write_vtu
     pvd = None
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        if vtu:
-            from .export import PvdWriter
+    if out is not None and vtu:
+        from .export import PvdWriter
 
-            pvd = PvdWriter(out)
+        pvd = PvdWriter(out)
     u = np.zeros(problem.dm.n_full)
     lam0, step0, wall0 = 0.0, 0, 0.0
     message = ""
@@ -218,11 +250,12 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     if ctl is not None:
         summary["first_delamination_load_factor"] = None
         summary["debonded_area"] = []
-    hash_ = checkpoint.model_hash(spec) if out is not None else ""
     from .plots import ZoneHistory
 
-    zones = ZoneHistory(ctl)  # debonded flags per step for the zone maps (records nothing without interfaces)
+    zones = ZoneHistory(ctl, keep=spec.output.zone_steps)  # debonded flags of the steps the zone maps may show
+    history: list[dict] = []
     if ck is not None:
+        history, legacy_pvd = _history(ck, restart)
         u, lam0, step0 = ck.u.copy(), ck.load_factor, ck.step
         _restore_zones(zones, ck.extra)
         if ctl is not None:
@@ -234,30 +267,70 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
             raise checkpoint.CheckpointError(f"--restart '{restart}': the checkpoint has an interface state but the "
                                              "model has no [[interfaces]]; rerun without --restart")
         wall0 = float(ck.summary.pop("wall_seconds", 0.0))
+        ck.summary.pop("debonded_area", None)
         summary.update(ck.summary)
+        summary["steps"] = [{k: v for k, v in r.items() if k not in _IN_SUMMARY_ONLY} for r in history]
+        if ctl is not None:
+            summary["debonded_area"] = [{"step": r["step"], "load_factor": r["load_factor"], **r["debonded_area"]}
+                                        for r in history if "debonded_area" in r]
         summary["restarts"] = list(summary.get("restarts", [])) + [{"step": step0, "load_factor": lam0}]
-        rows = [list(r) for r in ck.rows]
         if pvd is not None:
             base = checkpoint.locate(restart).parent
-            for key, entries in ck.pvd.items():
+            series: dict[str, list] = {k: list(v) for k, v in legacy_pvd.items()}
+            for r in history:
+                for key, f in (r.get("files") or {}).items():
+                    series.setdefault(key, []).append((r["load_factor"], f))
+            for key, entries in series.items():
                 pvd.series[key] = _rebase(entries, base, out)
+            if base.resolve() != out.resolve():  # the history's files now live elsewhere: paths relative to out
+                for r in history:
+                    if r.get("files"):
+                        r["files"] = {k: _rebase([(0.0, f)], base, out)[0][1] for k, f in r["files"].items()}
+    if rcd is not None:
+        rcd.begin(names, history)
+        if pvd is not None:
+            pvd.write()
+            rcd.register([f"{k}.pvd" for k in pvd.series])
+        log(f"layershell {_version()} run of {spec.path} ({summary['n_elements']} elements, {summary['n_dofs']} "
+            f"DOFs, {n_steps} load step(s))" + (f", restarted after step {step0}" if ck is not None else ""))
     resolves = {"n": 0}
+    live = {"step": step0 + 1, "load_factor": lam0}
     last = ck  # the state of the last converged step (written again when the run stops)
     interrupted = False
+    stop_signal: str | None = None
     failure: dict | None = None
     pending: BaseException | None = None
 
+    def debonded_total() -> float:
+        return float(sum(ctl.debonded_area().values())) if ctl is not None else 0.0
+
     def on_step_end(pb, uu, lam):
+        before = debonded_total()
         again = ctl.update(pb, uu, lam)
         resolves["n"] += int(again)
+        after = debonded_total()
+        if again or after != before:
+            log(f"step {live['step']} λ = {lam:.6g}: bond/contact update, debonded area {before:.6g} → {after:.6g}"
+                + (", re-solving" if again else ""))
         return again
 
-    def write_files() -> None:
-        summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
-        write_json(out / "summary.json", summary)
-        write_csv(out / "probes.csv", ["step", "load_factor", "iterations"] + names, rows)
-        if ctl is not None:
-            write_delamination_table(out / "delamination.csv", summary["steps"])
+    def on_iteration(it: int, lam: float, rn: float, scale: float, energy) -> None:
+        live["load_factor"] = lam
+        info = {"step": live["step"], "iteration": it, "load_factor": lam, "residual": rn,
+                "relative_residual": rn / scale if scale else float("nan"), "energy": energy,
+                "resolves": resolves["n"], "debonded_area": debonded_total()}
+        if rcd is not None:
+            log(f"step {info['step']} λ = {lam:.6g} iteration {it}: residual {rn:.3e} "
+                f"(relative {info['relative_residual']:.3e})"
+                + (f", energy norm {energy:.3e}" if energy is not None else ""))
+        if monitor is not None:
+            monitor(info)
+
+    problem.monitor = on_iteration  # called by the Newton loop (solver/newton.py)
+
+    def checkpoint_summary() -> dict:
+        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds")
+                if k in summary}
 
     if progress is not None and step0:
         progress(step0, n_steps, lam0)
@@ -292,19 +365,27 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals
-                rows.append([st.step, st.load_factor, st.iterations] + [vals[n] for n in names])
-                if out is not None:
+                if rcd is not None:
+                    files = None
                     if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
                         from .export import export_step
 
                         paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl)
+                        rcd.register(paths.values())
+                        rcd.register([f"{k}.pvd" for k in paths])
                         pvd.add(st.step, st.load_factor, paths)
+                        files = {k: pvd._rel(p) for k, p in paths.items()}
+                    rcd.step(rec, files)
                     summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
-                                              ctl.state(problem) if ctl is not None else None, summary, rows,
-                                              pvd.series if pvd is not None else {}, _zone_arrays(zones))
-                    checkpoint.save(out / checkpoint.FILENAME, last)
-                    write_files()
+                                              ctl.state(problem) if ctl is not None else None, checkpoint_summary(),
+                                              [], {}, _zone_arrays(zones))
+                    checkpoint.save(rcd.path(checkpoint.FILENAME), last)
+                    rcd.summary(summary)
+                    log(f"step {st.step} converged: λ = {st.load_factor:.6g}, {st.iterations} iteration(s), "
+                        f"{st.bisections} bisection(s), {st.wall_seconds:.3f} s"
+                        + (f", debonded area {debonded_total():.6g}" if ctl is not None else ""))
+                live["step"] = st.step + 1
             _fresh_linear_solvers(problem)
             if progress is not None:
                 progress(st.step, n_steps, st.load_factor)
@@ -317,32 +398,43 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
             message += f" (last residual {exc.residual:.3e})"
         summary["error"] = message
         summary["failure"] = failure
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
         interrupted = True
+        stop_signal = "SIGTERM" if isinstance(exc, Terminated) else "SIGINT"
         done = summary["steps"][-1] if summary["steps"] else None
-        message = ("interrupted by the user " + (f"after step {done['step']} (load factor {done['load_factor']:.6g})"
-                                                  if done else "before the first load step converged")
+        who = "stopped by SIGTERM " if stop_signal == "SIGTERM" else "interrupted by the user "
+        message = (who + (f"after step {done['step']} (load factor {done['load_factor']:.6g})"
+                          if done else "before the first load step converged")
                    + "; the converged steps are kept")
         summary["error"] = message
         summary["interrupted"] = True
+        summary["signal"] = stop_signal
     except Exception as exc:  # write what is done, then let the caller report it
         pending = exc
         summary["error"] = f"{type(exc).__name__}: {exc}"
+    finally:
+        problem.monitor = None
     with _sigint_deferred(reraise=False):  # the run stops anyway: finish writing
-        if out is not None and last is not None and last is not ck:
-            checkpoint.save(out / checkpoint.FILENAME, last)  # again: a Ctrl-C may have hit the step's writes
-        if pending is not None:
-            if out is not None:
-                write_files()
-            raise pending
+        if rcd is not None:
+            if message or pending is not None:
+                log(f"stopped: {summary.get('error')}")
+            if last is not None and last is not ck:
+                checkpoint.save(rcd.path(checkpoint.FILENAME), last)  # again: a signal may have hit the step's writes
         summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
-        if out is not None and spec.profiles and summary["steps"]:
-            summary["profiles"] = write_profiles(spec, problem, u, out)
-        if out is not None:
-            write_files()
+        if pending is not None:
+            if rcd is not None:
+                rcd.summary(summary, force=True)
+            raise pending
+        if rcd is not None and spec.profiles and summary["steps"]:
+            summary["profiles"] = write_profiles(spec, problem, u, rcd)
+        if rcd is not None:
+            rcd.summary(summary, force=True)
             if spec.output.plots:
                 from .plots import write_figures
 
-                write_figures(out, spec, problem, u, summary, zones)
-    res = RunResult(summary["converged"], summary, problem, u, message, interrupted=interrupted, failure=failure)
-    return res
+                figs = write_figures(out, spec, problem, u, summary, zones, through_thickness=through_thickness)
+                rcd.register(list(figs))
+            log(f"finished: {'converged' if summary['converged'] else summary.get('error', 'stopped')}, "
+                f"{len(summary['steps'])} step(s), {summary['wall_seconds']:.3f} s")
+    return RunResult(summary["converged"], summary, problem, u, message, interrupted=interrupted, failure=failure,
+                     signal=stop_signal)

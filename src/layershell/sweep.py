@@ -231,7 +231,7 @@ def run_variant(index: int, values: dict[str, Any], data: dict, base: str, out: 
         write_json(Path(out) / "variant.json", {"model_file": model_file, "variant": index, "values": values,
                                                 "model": data})
         spec = build_spec(data, Path(base), f"variant {index} ({describe(values)})")
-        res = run(spec, Path(out), write_vtu=vtu)
+        res = run(spec, Path(out), write_vtu=vtu, overwrite=True)
         s = res.summary
         rec.update(converged=bool(res.converged), probes=dict(s.get("probes", {})), steps=len(s.get("steps", [])),
                    load_factor=s["steps"][-1]["load_factor"] if s.get("steps") else None,

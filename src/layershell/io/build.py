@@ -22,15 +22,13 @@ from pydantic import BaseModel, ValidationError
 
 from .. import mesh as meshmod
 from ..element.shape import EDGES
-from ..formula import FormulaError, compile_formula
+from ..formula import FormulaError
 from ..material import MaterialError, Orthotropic
 from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry
 from ..solver.newton import NewtonSettings
 from . import schema
-
-
-class InputError(ValueError):
-    """Bad input, with a message for the user (exit code 2 in the CLI)."""
+from .errors import XYZ, InputError  # defined apart: io/probes.py needs them without importing this module
+from .errors import formula as _formula
 
 
 @dataclass
@@ -43,9 +41,6 @@ class RunSpec:
     source: schema.ModelFile
     path: Path | None = None
     profiles: list = field(default_factory=list)
-
-
-XYZ = ("x", "y", "z")
 
 
 def _fmt_loc(loc) -> str:
@@ -236,13 +231,6 @@ def load(path: str | Path) -> RunSpec:
 
 
 # ------------------------------------------------------------------ helpers
-def _formula(text, variables, field: str):
-    try:
-        return compile_formula(str(text), variables)
-    except FormulaError as exc:
-        raise InputError(f"'{field}': {exc}") from None
-
-
 def _field_fn(value, field: str, variables=XYZ):
     """Number or formula -> vectorised callable of keyword arrays."""
     if isinstance(value, (int, float)):

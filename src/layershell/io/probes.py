@@ -101,7 +101,7 @@ def _node_points(model, nodes):
 
 
 def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
-    from .build import InputError
+    from .errors import InputError
 
     out = []
     for i, pd in enumerate(mf.probes):
@@ -157,7 +157,8 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
 
 def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     """A probe of the whole state: the load factor, or a debonded area of an interface."""
-    from .build import XYZ, InputError, _formula
+    from .errors import XYZ, InputError
+    from .errors import formula as _formula
 
     unused = {"point": pd.point, "set": pd.set, "component": pd.component}
     if pd.quantity == "load_factor":

@@ -146,7 +146,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     Fext = problem.external(lam)
     ref = np.linalg.norm(op.reduce(Fext))
     res = NewtonResult(False, 0)
-    e0 = None
+    e0 = en = None
+    monitor = getattr(problem, "monitor", None)  # progress/run.log: (iteration, λ, ‖r‖, reference, energy norm)
     globalise = s.line_search and bool(problem.assembler.extra)  # contact: non-smooth
     # forces first, the tangent only where an iteration needs it: an iteration that converges,
     # and every trial step of the line search, costs one force evaluation (about 1/15 of a
@@ -161,6 +162,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.message = "residual is not finite"
             return u, res
         scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
+        if monitor is not None:
+            monitor(it, lam, rn, scale, en)
         if it > 0 and rn <= s.tol_residual * scale:
             res.converged, res.iterations = True, it
             return u, res
