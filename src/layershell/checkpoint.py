@@ -9,10 +9,16 @@ NumPy arrays only (read with ``allow_pickle=False``):
 * ``itf/...``: the interface controller's state (bond flags, g_T^max, slip, gap, contact
   pressure, friction loads and return-mapping state, failure function, first failure), see
   :meth:`~layershell.solver.interface_state.InterfaceController.state`;
-* ``summary`` (JSON text): the summary entries so far (steps, probes, debonded areas, first
-  delamination, restarts), ``rows`` (JSON: the probes.csv rows) and ``pvd`` (JSON: the ParaView
-  series written so far, paths relative to the results folder);
-* ``extra/...``: other per-step records of the run (the debonded flags per step of the zone maps).
+* ``summary`` (JSON text): the last probes, first delamination, restarts and wall time; the step
+  records themselves are in ``steps.jsonl`` next to it (one line per converged step, appended by
+  :class:`~layershell.recorder.Recorder`), so that the checkpoint's size does not grow with the
+  number of steps. ``rows`` and ``pvd`` are empty (checkpoints written before steps.jsonl held
+  the probes.csv rows and the ParaView series there, and the steps in ``summary``; they are
+  still read);
+* ``extra/...``: the debonded flags of the steps the zone maps may show (bounded, see
+  :class:`~layershell.plots.ZoneHistory`).
+
+A checkpoint holding NaN or infinite displacements is refused (:func:`load`).
 
 ``layershell run MODEL --restart DIR`` continues from it (:func:`layershell.runner.run`).
 """
@@ -149,6 +155,14 @@ def load(where: str | Path) -> Checkpoint:
                             {k[4:]: np.array(z[k]) for k in z.files if k.startswith("itf/")},
                             json.loads(str(z["summary"])), json.loads(str(z["rows"])), json.loads(str(z["pvd"])),
                             {k[6:]: np.array(z[k]) for k in z.files if k.startswith("extra/")}, version)
+        bad = [name for name, v in (("u", ck.u), ("load_factor", ck.load_factor), ("load_factors", ck.load_factors))
+               if not np.all(np.isfinite(v))]
+        bad += [f"itf/{k}" for k, v in ck.interface_state.items()
+                if v.dtype.kind == "f" and np.isinf(v).any()]  # NaN marks "not yet" in some histories
+        if bad:
+            raise CheckpointError(f"--restart '{where}': {path.name} holds NaN or infinite values ({', '.join(bad)}), "
+                                  "so it is no state to continue from (damaged, or written by a diverged run); rerun "
+                                  "the model from the start without --restart")
     except CheckpointError:
         raise
     except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile, json.JSONDecodeError) as exc:

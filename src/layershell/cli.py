@@ -67,7 +67,11 @@ def _traceback_wanted() -> bool:
 def _results_folder(out_dir: Path | None, model: Path, suffix: str) -> Path:
     """``--out`` or results/<model name><suffix>; a file there is bad input."""
     out_dir = out_dir or Path("results") / f"{model.stem}{suffix}"
-    if out_dir.exists() and not out_dir.is_dir():
+    try:
+        is_file = out_dir.exists() and not out_dir.is_dir()
+    except OSError as exc:
+        _fail(_os_error_message(exc, out_dir))
+    if is_file:
         _fail(f"--out '{out_dir}' is a file, not a folder; give a folder for the results")
     return out_dir
 
@@ -82,6 +86,8 @@ def _load(model: Path):
         return spec
     except InputError as exc:
         _fail(str(exc))
+    except OSError as exc:  # e.g. a name too long for the file system
+        _fail(_os_error_message(exc, None, reading=model))
     except Exception as exc:  # last line of defence: never a traceback
         if _traceback_wanted():
             raise
@@ -286,6 +292,8 @@ def run(
         err.print(f"warning: {len(numeric)} numerical warning(s) during the solution (first: {escape(first)}); check "
                   "summary.json and probes.csv for NaN or infinite values", soft_wrap=True, highlight=False)
     s = res.summary
+    for note in s.get("warnings", []):
+        err.print(f"warning: {escape(note)}", soft_wrap=True, highlight=False)
     if not quiet:
         for k, v in s["probes"].items():
             out.print(f"  {k:24s} = {v: .6g}", highlight=False)
@@ -309,11 +317,19 @@ def _install_sigterm(handler):
         return None
 
 
-def _os_error_message(exc: OSError, out_dir: Path) -> str:
-    """One paragraph for a file that cannot be written (name too long, no space, no permission)."""
+def _os_error_message(exc: OSError, out_dir: Path | None, reading: Path | None = None) -> str:
+    """One paragraph for a file that cannot be written (name too long, no space, no permission),
+    or, with ``reading``, for a model file that cannot be read."""
     import errno
 
-    name = getattr(exc, "filename", None) or out_dir
+    name = getattr(exc, "filename", None) or out_dir or reading
+    if reading is not None:
+        if exc.errno == errno.ENAMETOOLONG:
+            return (f"cannot read the model file '{reading}': its name is too long for the file system "
+                    f"({len(Path(reading).name)} characters; at most 255 bytes per file or folder name); rename "
+                    "the file")
+        return (f"cannot read '{name}' (needed by the model file '{reading}'): {exc.strerror or exc}; check the "
+                "path and the permissions")
     if exc.errno == errno.ENAMETOOLONG:
         return (f"cannot write the results: the path '{name}' is too long for the file system (a file or folder "
                 "name may have at most 255 bytes); choose a shorter folder with --out or a shorter model file name")

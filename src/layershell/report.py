@@ -87,6 +87,19 @@ def _read_json(path: Path) -> dict | None:
     return data if isinstance(data, dict) else None
 
 
+def _json_problem(path: Path) -> str:
+    """Why ``path`` is not a JSON object (for the error message)."""
+    try:
+        data = json.loads(path.read_text(encoding="utf-8"))
+    except UnicodeDecodeError:
+        return "not UTF-8 text"
+    except ValueError as exc:
+        return f"not JSON: {exc}"
+    except OSError as exc:
+        return exc.strerror or str(exc)
+    return f"a JSON {type(data).__name__}, not an object" if not isinstance(data, dict) else "empty"
+
+
 def _model_file(folder: Path, summary: dict, model: str | Path | None) -> str:
     if model is not None:
         return str(model)
@@ -117,10 +130,15 @@ def render(folder: str | Path, model: str | Path | None = None) -> str:
     if not any((folder / k).is_file() for k in KNOWN):
         raise InputError(f"'{folder}' holds none of {', '.join(KNOWN)}; give the folder that `layershell run "
                          "MODEL --out DIR` (or sweep/calibrate) wrote")
+    if model is not None and not Path(model).is_file():
+        raise InputError(f"--model '{model}': no such file; give the model file of the run (it is named in the "
+                         "report), or leave --model out to take the name recorded in summary.json")
     summary = _read_json(folder / "summary.json") or {}
     notes: list[str] = []
     if (folder / "summary.json").is_file() and not summary:
-        notes.append("summary.json could not be read (not JSON); its tables are left out.")
+        raise InputError(f"'{folder / 'summary.json'}' cannot be read ({_json_problem(folder / 'summary.json')}), so "
+                         "the report would lack the run's results; the file is damaged (cut short or edited): rerun "
+                         "the model into this folder (layershell run MODEL --out DIR) or restore the file")
     title = summary.get("title") or folder.name
     now = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     run_time = _utc((folder / "summary.json").stat().st_mtime) if (folder / "summary.json").is_file() else ""

@@ -432,8 +432,18 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
             if spec.output.plots:
                 from .plots import write_figures
 
-                figs = write_figures(out, spec, problem, u, summary, zones, through_thickness=through_thickness)
-                rcd.register(list(figs))
+                try:
+                    figs = write_figures(out, spec, problem, u, summary, zones, through_thickness=through_thickness)
+                    rcd.register(list(figs))
+                except Exception as exc:  # NaN/inf results cannot be drawn: the numbers are written, say so
+                    finite = np.isfinite(u).all() and all(np.isfinite(v) for v in summary["probes"].values()
+                                                          if isinstance(v, (int, float)))
+                    why = f"{type(exc).__name__}: {exc}" if finite else "the results hold NaN or infinite values"
+                    note = (f"the figures could not be drawn ({why}); summary.json, probes.csv and the ParaView "
+                            "files are written")
+                    summary.setdefault("warnings", []).append(note)
+                    log(f"warning: {note}")
+                    rcd.summary(summary, force=True)
             log(f"finished: {'converged' if summary['converged'] else summary.get('error', 'stopped')}, "
                 f"{len(summary['steps'])} step(s), {summary['wall_seconds']:.3f} s")
     return RunResult(summary["converged"], summary, problem, u, message, interrupted=interrupted, failure=failure,
