@@ -173,6 +173,28 @@ def test_ctrl_c_stops_cleanly_and_can_be_restarted(tiny, tmp_path):
     assert all(f in pvd for f in files) and all((part / f).is_file() for f in files)
 
 
+def test_sigterm_ends_like_ctrl_c(tiny, tmp_path):
+    """SIGTERM after step 2 (what a batch system or `kill` sends): exit code 143, one paragraph
+    naming SIGTERM with the restart command, the finished steps kept (summary.json with
+    'interrupted' and 'signal', probes.csv, checkpoint); the restart reaches the uninterrupted
+    result."""
+    part = tmp_path / "part"
+    p, seen, stderr = _run_and_signal(tiny, part, 2, signal.SIGTERM, ["--no-vtu"])
+    assert p.returncode == 143, stderr
+    assert "Traceback" not in stderr
+    msg = " ".join(stderr.split())
+    assert msg.startswith("error:") and "SIGTERM" in msg and f"--restart {part}" in msg, msg
+    s = json.loads((part / "summary.json").read_text(encoding="utf-8"))
+    assert s["interrupted"] is True and s["signal"] == "SIGTERM" and s["converged"] is False
+    k = len(s["steps"])
+    assert 2 <= k < N_STEPS and _checkpoint_step(part) == k
+    assert len(np.loadtxt(part / "probes.csv", delimiter=",", skiprows=1, ndmin=2)) == k
+    assert "stopped: stopped by SIGTERM" in (part / "run.log").read_text(encoding="utf-8")
+    r = _cli(["run", str(tiny), "--restart", str(part), "--no-vtu", "--quiet"], tmp_path)
+    assert r.exit_code == 0, r.output
+    _assert_same_state(tiny.parent / "full", part)
+
+
 def test_restart_needs_the_saved_interface_state(tiny, tmp_path):
     """Control for the comparisons above: from the same step-3 checkpoint, the in-process restart
     with the saved interface state reproduces the uninterrupted run to 1e-10, while the same
