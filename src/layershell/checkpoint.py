@@ -99,8 +99,10 @@ def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarr
                       {k: np.array(v, copy=True) for k, v in (extra or {}).items()})
 
 
-def save(path: Path, ck: Checkpoint) -> None:
-    """Write ``ck`` to ``path`` atomically (a reader or a killed writer never leaves a partial file)."""
+def save(path: Path, ck: Checkpoint, fsync: bool = True) -> None:
+    """Write ``ck`` to ``path`` atomically (a reader or a killed writer never leaves a partial file).
+    ``fsync``: also force it onto the disk before the rename (survives a power failure, not only
+    a killed process; costs milliseconds, so the recorder asks for it at a bounded rate)."""
     arrays = {
         "format_version": np.array(ck.format_version),
         "model_hash": np.array(ck.model_hash),
@@ -119,7 +121,8 @@ def save(path: Path, ck: Checkpoint) -> None:
         with open(tmp, "wb") as f:
             np.savez(f, **arrays)
             f.flush()
-            os.fsync(f.fileno())
+            if fsync:
+                os.fsync(f.fileno())
 
     atomic_write(Path(path), write)
 

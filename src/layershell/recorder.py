@@ -158,6 +158,7 @@ class Recorder:
         self._delam_names: list[str] | None = None
         self._summary_t = -1e300  # time of the last summary.json write
         self._summary_cost = 0.0
+        self._sync_t = -1e300  # time of the last fsync of the checkpoint
 
     # ----------------------------------------------------------------- folder ownership
 
@@ -305,6 +306,16 @@ class Recorder:
                 self._start_delam([rec])
             else:
                 self._delam.append(self._delam_row(rec))
+
+    def sync_due(self, every: float = 5.0) -> bool:
+        """Whether the checkpoint written now should be forced onto the disk (fsync): at most every
+        ``every`` seconds (a killed process loses nothing either way; this bounds what a power
+        failure can cost without paying an fsync per step)."""
+        now = time.monotonic()
+        if now - self._sync_t >= every:
+            self._sync_t = now
+            return True
+        return False
 
     def summary(self, summary: dict, force: bool = False) -> bool:
         """Rewrite summary.json: always with ``force``, otherwise only when the time since the last

@@ -380,7 +380,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
                                               ctl.state(problem) if ctl is not None else None, checkpoint_summary(),
                                               [], {}, _zone_arrays(zones))
-                    checkpoint.save(rcd.path(checkpoint.FILENAME), last)
+                    checkpoint.save(rcd.path(checkpoint.FILENAME), last, fsync=rcd.sync_due())
                     rcd.summary(summary)
                     log(f"step {st.step} converged: λ = {st.load_factor:.6g}, {st.iterations} iteration(s), "
                         f"{st.bisections} bisection(s), {st.wall_seconds:.3f} s"
@@ -418,8 +418,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         if rcd is not None:
             if message or pending is not None:
                 log(f"stopped: {summary.get('error')}")
-            if last is not None and last is not ck:
-                checkpoint.save(rcd.path(checkpoint.FILENAME), last)  # again: a signal may have hit the step's writes
+            if last is not None and last is not ck:  # again (with fsync): a signal may have hit the step's writes
+                checkpoint.save(rcd.path(checkpoint.FILENAME), last)
         summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
         if pending is not None:
             if rcd is not None:
