@@ -269,6 +269,10 @@ def test_a_runs_appended_files_equal_a_rewrite_from_the_summary(tmp_path):
     res = run(spec, out, write_vtu=True)
     assert res.converged
     steps = res.summary["steps"]
+    log = (out / "run.log").read_text(encoding="utf-8")  # bond and contact changes are logged
+    first = next(s["step"] for s in steps if sum(s["debonded_area"].values()) > 0)
+    assert f"step {first} λ = " in log and "bond/contact update, debonded area 0 → " in log
+    assert "contact points" in log and "changed)" in log
     names = [p.name for p in spec.probes]
     rows = [[s["step"], s["load_factor"], s["iterations"]] + [s["probes"][n] for n in names] for s in steps]
     assert (out / "probes.csv").read_text() == csv_text(["step", "load_factor", "iterations"] + names, rows)

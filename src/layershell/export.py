@@ -281,14 +281,14 @@ def append_pvd(path: Path, entries: list[tuple[float, str]]) -> None:
     path = Path(path)
     tail = _PVD_TAIL.encode()
     data = "".join(_pvd_entry(t, f) for t, f in entries).encode("utf-8") + tail
-    fd = os.open(path, os.O_RDWR)
-    try:
-        size = os.fstat(fd).st_size
-        if size >= len(tail) and os.pread(fd, len(tail), size - len(tail)) == tail:
-            os.pwrite(fd, data, size - len(tail))
-            return
-    finally:
-        os.close(fd)
+    with open(path, "r+b", buffering=0) as f:
+        size = f.seek(0, os.SEEK_END)
+        if size >= len(tail):
+            f.seek(size - len(tail))
+            if f.read(len(tail)) == tail:
+                f.seek(size - len(tail))
+                f.write(data)  # one unbuffered write
+                return
     raise ValueError(f"{path} does not end with the closing tags of a collection")
 
 

@@ -64,8 +64,9 @@ def _lock(folder: Path) -> int:
             msvcrt.locking(fd, msvcrt.LK_NBLCK, 1)
     except OSError:
         try:
-            holder = json.loads(os.pread(fd, 65536, 0).decode("utf-8") or "{}")
-        except (OSError, ValueError, AttributeError):
+            os.lseek(fd, 0, os.SEEK_SET)
+            holder = json.loads(os.read(fd, 65536).decode("utf-8") or "{}")
+        except (OSError, ValueError):
             holder = {}
         os.close(fd)
         who = (f"PID {holder.get('pid')} on {holder.get('host')}, started {holder.get('started')}"
@@ -78,7 +79,8 @@ def _lock(folder: Path) -> int:
             "started": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC"),
             "command": " ".join(sys.argv)}
     os.ftruncate(fd, 0)
-    os.pwrite(fd, json.dumps(info).encode("utf-8"), 0)
+    os.lseek(fd, 0, os.SEEK_SET)
+    os.write(fd, json.dumps(info).encode("utf-8"))
     return fd
 
 

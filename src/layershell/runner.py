@@ -314,15 +314,26 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                 + (", re-solving" if again else ""))
         return again
 
-    def on_iteration(it: int, lam: float, rn: float, scale: float, energy) -> None:
+    contact = [b for b in problem.assembler.extra if hasattr(b, "gap") and hasattr(b, "released")]
+
+    def on_iteration(it: int, lam: float, rn: float, scale: float, energy, uu=None) -> None:
         live["load_factor"] = lam
         info = {"step": live["step"], "iteration": it, "load_factor": lam, "residual": rn,
                 "relative_residual": rn / scale if scale else float("nan"), "energy": energy,
                 "resolves": resolves["n"], "debonded_area": debonded_total()}
         if rcd is not None:
-            log(f"step {info['step']} λ = {lam:.6g} iteration {it}: residual {rn:.3e} "
-                f"(relative {info['relative_residual']:.3e})"
-                + (f", energy norm {energy:.3e}" if energy is not None else ""))
+            line = (f"step {info['step']} λ = {lam:.6g} iteration {it}: residual {rn:.3e} "
+                    f"(relative {info['relative_residual']:.3e})"
+                    + (f", energy norm {energy:.3e}" if energy is not None else ""))
+            if contact and uu is not None:  # points in contact (released and closed), and how many changed
+                now = [b.released & (b.gap(uu) <= 0.0) for b in contact]
+                n = int(sum(int(a.sum()) for a in now))
+                prev = live.get("contact")
+                changed = (int(sum(int((a != b).sum()) for a, b in zip(now, prev)))
+                           if prev is not None and all(a.shape == b.shape for a, b in zip(now, prev)) else None)
+                live["contact"] = now
+                line += f", contact points {n}" + (f" ({changed} changed)" if changed else "")
+            log(line)
         if monitor is not None:
             monitor(info)
 

@@ -147,7 +147,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     ref = np.linalg.norm(op.reduce(Fext))
     res = NewtonResult(False, 0)
     e0 = en = None
-    monitor = getattr(problem, "monitor", None)  # progress/run.log: (iteration, λ, ‖r‖, reference, energy norm)
+    monitor = getattr(problem, "monitor", None)  # progress/run.log: (iteration, λ, ‖r‖, reference, energy norm, u)
     globalise = s.line_search and bool(problem.assembler.extra)  # contact: non-smooth
     # forces first, the tangent only where an iteration needs it: an iteration that converges,
     # and every trial step of the line search, costs one force evaluation (about 1/15 of a
@@ -163,7 +163,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
         if monitor is not None:
-            monitor(it, lam, rn, scale, en)
+            monitor(it, lam, rn, scale, en, u)
         if it > 0 and rn <= s.tol_residual * scale:
             res.converged, res.iterations = True, it
             return u, res
