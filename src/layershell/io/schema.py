@@ -314,9 +314,14 @@ class Steps(Strict):
 
 class ProbeDef(Strict):
     name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
-    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor"] = Field(
+    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor", "reaction",
+                      "resultant"] = Field(
         description="debonded_area: released area of the interface below `layer` (within `where`, a formula "
-                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units)")
+                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units); "
+                    "reaction: force (component x|y|z) or moment about the origin (mx|my|mz) that the supports "
+                    "exert at the selected nodes (where/set/point), R = f_int − F_ext summed over the nodes' "
+                    "rigid-body modes; resultant: stress resultant per unit width at `point`, integrated through "
+                    "all layers (component n|m|q|nt|mt on the section whose normal is `direction`)")
     point: Vec3 | None = Field(None, description="displacement: nearest node; stress: point on the reference surface")
     where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area: "
                                                 "interface points counted")
@@ -330,6 +335,16 @@ class ProbeDef(Strict):
     layer: str | None = None
     reduce: Literal["max", "min", "absmax", "mean", "none"] = "none"
     scale: FiniteFloat = 1.0
+    direction: Vec3 | None = Field(
+        None, description="resultant: normal of the section (a global vector, projected on the tangent plane); n, m: "
+                          "normal force and moment of the stresses along it, q: transverse shear, nt/mt: in-plane "
+                          "shear and twisting moment; per unit width")
+    about: FiniteFloat | None = Field(
+        None, description="resultant: Θ³ (from the reference face) of the axis of m and mt; default: mid-height of "
+                          "the stack at the point. m > 0 puts the side of larger Θ³ in tension")
+    unit: str | None = Field(
+        None, description="unit of the probe's value (after 'scale') written on plot axes, e.g. 'mm' or 'kN'; "
+                          "default: the unit system of [model] units")
 
     @field_validator("theta3")
     @classmethod
