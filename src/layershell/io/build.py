@@ -24,7 +24,7 @@ from .. import mesh as meshmod
 from ..element.shape import EDGES
 from ..formula import FormulaError, compile_formula
 from ..material import MaterialError, Orthotropic
-from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry, Tie
 from ..solver.newton import NewtonSettings
 from . import schema
 
@@ -457,6 +457,75 @@ def _edge_normals(m: meshmod.Mesh, nodes: np.ndarray, field: str) -> np.ndarray:
     return out
 
 
+def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) -> list[Tie]:
+    """A fix on a face, at a height, in a direction or through all layers (``layer = 'all'``) as
+    linear supports Σ_l c_l u_l · e = 0 (see :func:`layershell.constraints.apply_ties`)."""
+    layers = model.layers
+    if sd.direction is not None:
+        dirs = [_vec(sd.direction, f + ".direction")]
+    else:
+        if not sd.components:
+            raise InputError(f"'{f}.components': give at least one of 'x', 'y', 'z' (or a 'direction')")
+        dirs = [np.eye(3)["xyz".index(c)] for c in dict.fromkeys(sd.components)]
+    placed = sd.face is not None or sd.height is not None
+    if placed and sd.directors != [0]:
+        raise InputError(f"'{f}.directors': a support on a face or at a height holds the displacement there; "
+                         "remove 'directors'")
+    if sd.face is not None and sd.height is not None:
+        raise InputError(f"'{f}': give 'face' or 'height', not both")
+    out = []
+    if sd.layer == "all":
+        if placed:
+            raise InputError(f"'{f}': layer = 'all' holds the layers' director vectors through the whole thickness; "
+                             "remove 'face'/'height' or name one layer")
+        for k, ly in enumerate(layers):
+            dirs_k = range(ly.directors + 1) if sd.directors == "all" else sd.directors
+            if any(l > ly.directors or l < 0 for l in dirs_k):
+                raise InputError(f"'{f}.directors': layer '{ly.name}' has directors 0..{ly.directors}, got "
+                                 f"{list(dirs_k)}")
+            for l in dirs_k:
+                c = np.zeros((nodes.size, ly.directors + 1))
+                c[:, l] = 1.0
+                out += [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for e in dirs]
+        return out
+    if sd.layer is not None and sd.layer not in index:
+        raise InputError(f"'{f}.layer': unknown layer '{sd.layer}'; defined: {list(index)} (or 'all')")
+    k = index.get(sd.layer, first) if sd.layer is not None else None
+    if sd.height is not None:
+        h = float(sd.height)
+        if k is None:  # the layer containing the height at the nodes (the upper one at an interface)
+            cands = [j for j in range(len(layers))
+                     if np.all((model.offset(j)[nodes] <= h + 1e-9 * model.mesh.size())
+                               & (h <= (model.offset(j) + layers[j].thickness)[nodes] + 1e-9 * model.mesh.size()))]
+            if not cands:
+                raise InputError(f"'{f}.height': no layer contains Θ³ = {h:g} at all selected nodes (total thickness "
+                                 f"{model.total_thickness()[nodes].min():.6g} to "
+                                 f"{model.total_thickness()[nodes].max():.6g}); give a height inside the shell or "
+                                 "name the 'layer'")
+            k = max(cands, key=lambda j: model.offset(j)[nodes].mean())
+        theta = h - model.offset(k)[nodes]
+        H = layers[k].thickness[nodes]
+        if np.any(theta < -1e-9 * model.mesh.size()) or np.any(theta > H + 1e-9 * model.mesh.size()):
+            raise InputError(f"'{f}.height': Θ³ = {h:g} lies outside layer '{layers[k].name}' at some selected nodes; "
+                             "give a height inside the layer or leave 'layer' out")
+    else:
+        k = first if k is None else k
+        theta = (layers[k].thickness[nodes] if sd.face == "top" else np.zeros(nodes.size))
+    if sd.directors != [0] and not placed:
+        d = layers[k].directors
+        dl = range(d + 1) if sd.directors == "all" else sd.directors
+        if any(l > d or l < 0 for l in dl):
+            raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dl)}")
+        cs = []
+        for l in dl:
+            c = np.zeros((nodes.size, d + 1))
+            c[:, l] = 1.0
+            cs.append(c)
+    else:
+        cs = [theta[:, None] ** np.arange(layers[k].directors + 1)]
+    return [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for c in cs for e in dirs]
+
+
 def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
     """Interface laws, initially debonded zones and delamination settings (MODEL.md §9-§10)."""
     from ..delamination import InterfaceLaw
@@ -588,7 +657,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     for i, sd in enumerate(mf.supports):
         f = f"supports[{i}]"
         nodes = _node_selection(m, sd, f)
-        if sd.type == "fix":
+        if sd.type == "fix" and (sd.layer == "all" and "all" not in index or sd.face is not None
+                                 or sd.height is not None or sd.direction is not None):
+            model.ties.extend(_ties(model, sd, nodes, f, index, first))
+        elif sd.type == "fix":
             k = layer_idx(sd.layer, f + ".layer")
             k = first if k is None else k
             d = layers[k].directors

@@ -214,9 +214,21 @@ class FixDef(Strict):
     where: str | None = None
     set: str | None = None
     point: Vec3 | None = None
-    layer: str | None = Field(None, description="default: the layer at the reference face")
-    directors: Union[Literal["all"], list[int]] = [0]
-    components: list[Component] = ["x", "y", "z"]
+    layer: str | None = Field(
+        None, description="layer name, or 'all': every layer at the nodes (a support through the whole thickness); "
+                          "default: the layer at the reference face")
+    directors: Union[Literal["all"], list[int]] = Field(
+        [0], description="director vectors u_l held (u_0: the layer's bottom face); not with 'face'/'height'")
+    components: list[Component] = Field(["x", "y", "z"], description="global displacement components held")
+    face: Literal["bottom", "top"] | None = Field(
+        None, description="the support acts on this face of 'layer' (Σ_l (Θ_L³)^l u_l · e = 0; a bonded face "
+                          "is shared with the neighbour layer), e.g. layer = 'concrete', face = 'bottom' for a "
+                          "bearing under the concrete while another layer lies below it")
+    height: float | None = Field(
+        None, description="Θ³ (from the reference face, length) at which the support acts, inside 'layer' (default: "
+                          "the layer containing it; at an interface the upper one)")
+    direction: Vec3 | None = Field(
+        None, description="held direction (global vector, e.g. [0, 0, 1] for a bearing); instead of 'components'")
 
 
 class SymmetryDef(Strict):
@@ -233,8 +245,8 @@ class HingeDef(Strict):
     set: str | None = None
     point: Vec3 | None = None
     direction: Union[Vec3, Literal["edge-normal"]] = Field(
-        description="hinge direction: a global vector (not the thickness direction) or 'edge-normal', the in-plane "
-                    "normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
+        description="hinge direction: a global vector (any, the thickness direction included) or 'edge-normal', the "
+                    "in-plane normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
     height: float | None = Field(None, description="Θ³ of the hinge; default mid-thickness")
     fixed: bool = Field(True, description="fixed hinge (u0 of the first layer along 'direction' only) or sliding")
 
