@@ -109,6 +109,7 @@ class EdgeLoad:
     distribution: object
     scaled: bool = True
     at_face: str | None = None  # 'top' | 'reference': a line force per edge length on that face (2.180)
+    at_height: float | None = None  # a line force per edge length at this Θ_1³
 
 
 @dataclass

@@ -310,6 +310,19 @@ def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
     return el
 
 
+def nodal_normals(m: meshmod.Mesh) -> np.ndarray:
+    """(n_nodes, 3) unit normals A3 at the nodes, averaged over the elements sharing each node."""
+    from ..element.geometry import surface_points
+    from ..element.shape import NODE_XI
+
+    E = m.elements
+    sp = surface_points(m.nodes[E], np.broadcast_to(NODE_XI[:, 0], E.shape), np.broadcast_to(NODE_XI[:, 1], E.shape),
+                        per_element=True)
+    acc = np.zeros((m.n_nodes, 3))
+    np.add.at(acc, E.ravel(), sp.A3.reshape(-1, 3))
+    return acc / np.linalg.norm(acc, axis=1, keepdims=True)
+
+
 def boundary_edges(m: meshmod.Mesh) -> np.ndarray:
     """(n, 3) node triples of edges that belong to one element only."""
     tri = m.elements[:, EDGES].reshape(-1, 3)
@@ -454,6 +467,48 @@ def _edge_normals(m: meshmod.Mesh, nodes: np.ndarray, field: str) -> np.ndarray:
     if not found.all():
         raise InputError(f"'{field}.direction': 'edge-normal' needs nodes on the mesh boundary; "
                          f"{int((~found).sum())} selected node(s) are not on a boundary edge")
+    return out
+
+
+def _heights(model: Model, nodes: np.ndarray, height: float | None, face: str | None, k_given: int | None,
+             f: str, index: dict) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """Where a force at Θ³ = ``height`` or on ``face`` acts: ``(layer, mask of nodes, Θ_L³)``
+    per layer (the layer containing the height; the upper one at an interface)."""
+    layers = model.layers
+    tol = 1e-9 * model.mesh.size()
+    present = np.zeros((len(layers), nodes.size), bool)
+    for si, st in enumerate(model.stacks):
+        on = np.zeros(model.mesh.n_nodes, bool)
+        on[np.unique(model.mesh.elements[model.element_stack == si])] = True
+        for k in st:
+            present[k] |= on[nodes]
+    if face is not None:
+        if face == "reference":
+            h = np.zeros(nodes.size)
+        elif face == "top":
+            h = model.total_thickness()[nodes]
+        elif face.startswith("layer:") and face.split(":", 1)[1] in index:
+            k_given = index[face.split(":", 1)[1]]
+            h = model.offset(k_given)[nodes]
+        else:
+            raise InputError(f"'{f}.face': unknown face '{face}'; use 'reference', 'top' or 'layer:<name>' with a "
+                             f"layer of {list(index)}")
+    else:
+        h = np.full(nodes.size, float(height))
+    out, done = [], np.zeros(nodes.size, bool)
+    order = [k_given] if k_given is not None else sorted(range(len(layers)), key=lambda j: -model.offset(j)[nodes].max())
+    for k in order:
+        off = model.offset(k)[nodes]
+        inside = present[k] & ~done & (off - tol <= h) & (h <= off + layers[k].thickness[nodes] + tol)
+        if inside.any():
+            out.append((k, inside, np.clip(h - off, 0.0, None)[inside]))
+            done |= inside
+    if not done.all():
+        bad = int(np.flatnonzero(~done)[0])
+        raise InputError(f"'{f}': Θ³ = {h[bad]:g} lies outside "
+                         + (f"layer '{layers[k_given].name}'" if k_given is not None else "the shell")
+                         + f" at node {nodes[bad]} (total thickness {model.total_thickness()[nodes[bad]]:.6g}); give a "
+                         "height inside the shell")
     return out
 
 
@@ -648,6 +703,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
     first = stacks[0][0]
+    if mf.mesh.surface == "middle":
+        m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)
 
     # supports
     if not mf.supports:
@@ -732,9 +789,23 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                 _require_finite(_nodal_values(m, ld.distribution, f + ".distribution", pts, t=t),
                                 ld.distribution, f + ".distribution", "point of the loaded edges (t inside the "
                                 "thickness)")
+            if ld.height is not None and ld.face is not None:
+                raise InputError(f"'{f}': give 'face' or 'height' for a line force, not both")
             model.edge_loads.append(EdgeLoad(edges, _vec(ld.direction, f + ".direction"),
                                              lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled,
-                                             at_face=ld.face))
+                                             at_face=ld.face, at_height=ld.height))
+        elif ld.height is not None or ld.face is not None:  # nodal force at a height / on a face
+            nodes = _node_selection(m, ld, f)
+            if ld.director != 0:
+                raise InputError(f"'{f}.director': a force at a height or on a face is split into director forces "
+                                 "automatically; remove 'director'")
+            if ld.height is not None and ld.face is not None:
+                raise InputError(f"'{f}': give 'face' or 'height', not both")
+            k_given = layer_idx(ld.layer, f + ".layer")
+            for k, sel, th in _heights(model, nodes, ld.height, ld.face, k_given, f, index):
+                fl = np.asarray(ld.value, float)
+                for l in range(layers[k].directors + 1):
+                    model.nodal_loads.append(NodalLoad(nodes[sel], k, l, th[:, None] ** l * fl, ld.scaled))
         else:  # nodal
             nodes = _node_selection(m, ld, f)
             k = layer_idx(ld.layer, f + ".layer")

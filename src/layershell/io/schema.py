@@ -63,7 +63,16 @@ class ModelSettings(Strict):
 
 
 # ------------------------------------------------------------------ meshes
-class RectangleMesh(Strict):
+class MeshBase(Strict):
+    surface: Literal["reference", "middle"] = Field(
+        "reference", description="what the mesh describes: 'reference' the reference face (Θ³ = 0) itself, 'middle' "
+                                 "the mid-surface of the stack (e.g. a CAD/Gmsh shell), moved here by half the total "
+                                 "nodal thickness against the normal A3 (the averaged element normal at each node) "
+                                 "so that the stack lies half on each side; selections and points of supports, loads "
+                                 "and probes then refer to the moved (reference) face")
+
+
+class RectangleMesh(MeshBase):
     type: Literal["rectangle"]
     lx: PositiveFloat
     ly: PositiveFloat
@@ -73,7 +82,7 @@ class RectangleMesh(Strict):
     normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
 
 
-class CylinderMesh(Strict):
+class CylinderMesh(MeshBase):
     type: Literal["cylinder"]
     radius: PositiveFloat = Field(description="radius of the reference face")
     angle_start: float = 0.0
@@ -102,7 +111,7 @@ class MeridianSegment(Strict):
                           "default: straight")
 
 
-class RevolutionMesh(Strict):
+class RevolutionMesh(MeshBase):
     type: Literal["revolution"]
     meridian_r: list[float] = Field(min_length=2)
     meridian_z: list[float] = Field(min_length=2)
@@ -140,7 +149,7 @@ class RevolutionMesh(Strict):
         return self
 
 
-class FileMesh(Strict):
+class FileMesh(MeshBase):
     type: Literal["file"]
     path: str = Field(description="mesh file read with meshio (Gmsh .msh, .vtu, ...), relative to the model file")
     scale: PositiveFloat = 1.0
@@ -275,6 +284,9 @@ class EdgeLoadDef(Strict):
                     "with 'face': a line force per edge length on that face")
     face: Literal["top", "reference"] | None = Field(
         None, description="apply a line force on the edge of the top (opposite) or reference face, (2.175)/(2.180)")
+    height: float | None = Field(
+        None, description="a line force per edge length at this Θ³ (from the reference face, length), split into "
+                          "director forces (Θ_L³)^l q of the layer containing it (the upper one at an interface)")
     scaled: bool = True
 
 
@@ -302,7 +314,14 @@ class NodalLoadDef(Strict):
     point: Vec3 | None = None
     layer: str | None = None
     director: int = Field(0, ge=0, le=4)
-    value: Vec3
+    value: Vec3 = Field(description="force (director 0) or director force (force × length^director), global")
+    height: float | None = Field(
+        None, description="Θ³ (from the reference face, length) at which the force acts, e.g. the mid-surface; it is "
+                          "split into the director forces (Θ_L³)^l F of the layer containing it (the upper one at "
+                          "an interface, or 'layer'); not with 'director'")
+    face: str | None = Field(
+        None, description="'reference', 'top' or 'layer:<name>' (the bottom face of that layer): the force acts on "
+                          "that face (split into director forces like 'height')")
     scaled: bool = True
 
 
