@@ -354,7 +354,7 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
         raise InputError(f"'mesh': {size[1]} = {size[0]} elements is more than layershell can handle (at most "
                          f"{MAX_ELEMENTS}); use fewer elements")
     if md.type == "rectangle":
-        return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal)
+        return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal, md.grading_x, md.grading_y)
     if md.type == "cylinder":
         return meshmod.cylinder(md.radius, md.angle_start, md.angle_end, md.width, md.n_arc, md.n_width,
                                 md.normal, md.axis)

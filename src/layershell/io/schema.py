@@ -80,6 +80,10 @@ class RectangleMesh(MeshBase):
     ny: PositiveInt
     origin: Vec3 = [0.0, 0.0, 0.0]
     normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
+    grading_x: PositiveFloat = Field(
+        1.0, ge=1e-4, le=1e4, description="size of the last element along x over the first (geometric grading; > 1 refines "
+                                 "towards the origin edge, < 1 towards x = origin + lx; 1: uniform)")
+    grading_y: PositiveFloat = Field(1.0, ge=1e-4, le=1e4, description="the same along y")
 
 
 class CylinderMesh(MeshBase):
@@ -391,6 +395,15 @@ class ProbeDef(Strict):
         return v
 
 
+class PlotDef(Strict):
+    """A figure plot_<name>.png of one probe against another over the converged steps."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description="file name: plot_<name>.png")
+    x: str = Field(description="probe on the horizontal axis (e.g. the midspan deflection in mm)")
+    y: str = Field(description="probe on the vertical axis (e.g. a load_factor probe scaled to the load in kN/m²)")
+    title: str = Field("", description="figure title (default: 'y against x')")
+
+
 class ProfileDef(Strict):
     """Stress along the thickness at a point, one CSV column per layer, and a PNG plot."""
 
@@ -477,6 +490,7 @@ class ModelFile(Strict):
     steps: Steps = Steps()
     probes: list[ProbeDef] = []
     profiles: list[ProfileDef] = []
+    plots: list[PlotDef] = []
     interfaces: list[InterfaceDef] = []
     delamination: DelaminationDef = DelaminationDef()
     output: OutputDef = OutputDef()
@@ -502,4 +516,9 @@ class ModelFile(Strict):
         if dup:
             raise ValueError(f"'probes': probe names must be unique, but {sorted(dup)} appear more than once; "
                              "rename the probes")
+        for i, pl in enumerate(self.plots):
+            for axis in ("x", "y"):
+                if getattr(pl, axis) not in pn:
+                    raise ValueError(f"'plots[{i}].{axis}': unknown probe '{getattr(pl, axis)}'; defined: {pn} (add a "
+                                     "[[probes]] table, e.g. quantity = 'load_factor' with scale = the load)")
         return self
