@@ -282,7 +282,7 @@ def test_layer_all_on_the_thesis_cantilever_plate():
     concrete only leaves the TRC's directors free at the clamp; layer = 'all' holds both.
     Issue 15 reports 2 % for its own model; on this plate the difference is 0.16 % (linear,
     front-edge deflection)."""
-    from tests.helpers import run_example
+    from helpers import run_example
 
     common = {"nonlinear = true": "nonlinear = false", "n = 24": "n = 1"}
     one = run_example("cantilever_plate_bonded", common).summary["probes"]["w_front_max"]
