@@ -457,3 +457,20 @@ def test_mid_surface_mesh_equals_the_face_mesh():
     for k in ("R", "w_top"):
         assert b.summary["probes"][k] == pytest.approx(a.summary["probes"][k], rel=1e-8)
     assert np.abs(a.u - b.u).max() <= 1e-8 * np.abs(a.u).max()
+
+
+def test_report_embeds_the_model_file_as_run(tmp_path):
+    """summary.json keeps the model file's text as run; the report shows it even after the file
+    has been changed or removed."""
+    from layershell.io.build import load
+    from layershell.report import render
+
+    f = tmp_path / "strip.toml"
+    f.write_text(CANTILEVER.replace("[model]", '[model]\ntitle = "a <strip> & more"'), encoding="utf-8")
+    out = tmp_path / "res"
+    run(load(f), out, write_vtu=False)
+    f.unlink()
+    page = render(out)
+    assert 'id="model-text"' in page
+    assert 'title = &quot;a &lt;strip&gt; &amp; more&quot;' in page
+    assert "quantity = &quot;reaction&quot;" in page

@@ -108,22 +108,9 @@ class Probe:
     def reaction(self, model, dm, u, load_factor: float, problem=None) -> float:
         """Support force/moment at the nodes: ρ·(f_int(u) − F_ext(λ)) (the force the supports
         exert on the shell; with a ``problem`` its assembler, contact blocks and friction loads)."""
-        cache = self._cache if self._cache is not None and self._cache.get("model") is model else None
-        if cache is None:
-            cache = self._cache = {"model": model, "rho": self.rigid_mode(model, dm)}
-        if problem is not None:
-            f, _ = problem.assembler.evaluate(u, tangent=False)
-            F = problem.external(load_factor)
-        else:
-            if "asm" not in cache:
-                from ..assembly import Assembler
-                from ..loads import external_forces
-
-                cache["asm"] = Assembler(model, dm)
-                cache["F"] = external_forces(model, dm)
-            f, _ = cache["asm"].evaluate(u, tangent=False)
-            F = load_factor * cache["F"][0] + cache["F"][1]
-        return float(cache["rho"] @ (f - F))
+        if self._cache is None or self._cache.get("model") is not model:
+            self._cache = {"model": model, "rho": self.rigid_mode(model, dm)}
+        return float(self._cache["rho"] @ residual_forces(model, dm, u, load_factor, problem))
 
     # ------------------------------------------------------------ stress resultant
     def resultant(self, model, dm, u, n_gauss: int = 8) -> float:
@@ -191,6 +178,28 @@ class Probe:
         if self.reduce == "mean":
             return float(v.mean())
         return float(v[0])
+
+
+def residual_forces(model, dm, u: np.ndarray, load_factor: float, problem=None) -> np.ndarray:
+    """f_int(u) − F_ext(λ) in the full space: the forces of the constraints (supports, bonds)
+    on the shell. Without a ``problem``, an assembler of the bare elements is kept on the model
+    (contact and friction forces between layers act in equal and opposite pairs at a node and
+    drop out of a reaction); the last result is reused for the same ``u`` (all reaction probes
+    of a step)."""
+    if problem is not None:
+        f, _ = problem.assembler.evaluate(u, tangent=False)
+        return f - problem.external(load_factor)
+    cache = model.__dict__.setdefault("_reaction_cache", {})
+    if cache.get("dm") is not dm:
+        from ..assembly import Assembler
+        from ..loads import external_forces
+
+        cache.clear()
+        cache.update(dm=dm, asm=Assembler(model, dm), F=external_forces(model, dm))
+    if cache.get("lam") != load_factor or not np.array_equal(cache.get("u"), u):
+        f, _ = cache["asm"].evaluate(u, tangent=False)
+        cache.update(u=u.copy(), lam=load_factor, r=f - (load_factor * cache["F"][0] + cache["F"][1]))
+    return cache["r"]
 
 
 def _nodal_normals(model) -> np.ndarray:
