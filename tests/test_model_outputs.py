@@ -474,3 +474,25 @@ def test_report_embeds_the_model_file_as_run(tmp_path):
     assert 'id="model-text"' in page
     assert 'title = &quot;a &lt;strip&gt; &amp; more&quot;' in page
     assert "quantity = &quot;reaction&quot;" in page
+
+
+@pytest.mark.parametrize("support,message", [
+    ('layer = "concrete"\nface = "bottom"\ndirection = [0, 0, 1]\ncomponents = ["z"]', "not both"),
+    ('layer = "concrete"\nface = "bottom"\nheight = 0.01', "'face' or 'height'"),
+    ('layer = "all"\nface = "bottom"', "layer = 'all'"),
+    ('height = 0.5', "no layer contains"),
+    ('layer = "trc"\nheight = 0.05', "outside layer 'trc'"),
+    ('layer = "concrete"\nface = "bottom"\ndirectors = [1]', "remove 'directors'"),
+])
+def test_bad_supports_are_explained(support, message):
+    with pytest.raises(InputError, match=message):
+        build(parse(STRIP.replace("SUPPORT", support)))
+
+
+def test_bad_resultant_probe_is_explained():
+    text = CANTILEVER.replace('direction = [0, 1, 0]\ncomponent = "q"', 'direction = [0, 0, 1]\ncomponent = "q"')
+    with pytest.raises(InputError, match="along the shell normal"):
+        build(parse(text))
+    text = CANTILEVER.replace('direction = [0, 1, 0]\ncomponent = "q"', 'component = "q"')
+    with pytest.raises(InputError, match="needs the normal of the section"):
+        build(parse(text))

@@ -516,6 +516,8 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
     """A fix on a face, at a height, in a direction or through all layers (``layer = 'all'``) as
     linear supports Σ_l c_l u_l · e = 0 (see :func:`layershell.constraints.apply_ties`)."""
     layers = model.layers
+    if sd.direction is not None and "components" in sd.model_fields_set:
+        raise InputError(f"'{f}': give 'direction' (one held direction) or 'components' (global x, y, z), not both")
     if sd.direction is not None:
         dirs = [_vec(sd.direction, f + ".direction")]
     else:
