@@ -68,8 +68,9 @@ class MeshBase(Strict):
         "reference", description="what the mesh describes: 'reference' the reference face (Θ³ = 0) itself, 'middle' "
                                  "the mid-surface of the stack (e.g. a CAD/Gmsh shell), moved here by half the total "
                                  "nodal thickness against the normal A3 (the averaged element normal at each node) "
-                                 "so that the stack lies half on each side; selections and points of supports, loads "
-                                 "and probes then refer to the moved (reference) face")
+                                 "so that the stack lies half on each side (thickness formulas are evaluated on the mesh "
+                                 "as given); selections and points of supports, loads and probes then refer to the "
+                                 "moved (reference) face")
 
 
 class RectangleMesh(MeshBase):
