@@ -159,6 +159,14 @@ class RunResult:
     failure: dict | None = None  # non-convergence: step, load_factor, residual
 
 
+def _model_text(spec: RunSpec) -> str | None:
+    """The model file's text as run (embedded in the report)."""
+    try:
+        return spec.path.read_text(encoding="utf-8") if spec.path is not None else None
+    except (OSError, UnicodeDecodeError):
+        return None
+
+
 def _rebase(entries: list, old: Path, new: Path) -> list[tuple[float, str]]:
     """ParaView series entries (paths relative to ``old``) relative to ``new``."""
     if old.resolve() == new.resolve():
@@ -187,6 +195,7 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     summary = {
         "title": spec.source.model.title,
         "model_file": str(spec.path) if spec.path is not None else None,
+        "model_text": _model_text(spec),
         "version": _version(),
         "units": model.units,
         "converged": False,
