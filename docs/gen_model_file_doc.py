@@ -43,6 +43,8 @@ SECTIONS = [
     ("[steps]", schema.Steps, "Load stepping and Newton settings."),
     ("[[probes]]", schema.ProbeDef, "Named scalar outputs, one value per converged step."),
     ("[[profiles]]", schema.ProfileDef, "A stress component through the thickness at a point."),
+    ("[[plots]]", schema.PlotDef,
+     "A figure plot_<name>.png of one probe against another (e.g. load in kN/m² against deflection in mm)."),
     ("[[interfaces]]", schema.InterfaceDef, "Delamination and friction at the interface below a layer."),
     ("initially_debonded = [{...}]", schema.InitialZone, "Initially debonded zones of an interface."),
     ("[delamination]", schema.DelaminationDef, "Delamination solution settings."),

@@ -3,7 +3,7 @@ import re
 
 import numpy as np
 import pytest
-from helpers import EXAMPLES, run_example
+from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS, run_example
 
 from layershell.delamination import InterfaceLaw
 from layershell.interfaces import interface_state, interfaces
@@ -250,6 +250,8 @@ def test_step_cutting_on_debonding_jumps():
     a_plain = [a["concrete/trc"] for a in plain.summary["debonded_area"]]
     a_cut = [a["concrete/trc"] for a in cut.summary["debonded_area"]]
     assert a_plain[0] == a_cut[0] == 0.0
+    # the first step releases nothing, so both runs do the same operations on the same machine up
+    # to it (cutting only takes snapshots): equal to round-off of identical arithmetic
     assert cut.summary["steps"][0]["probes"]["w_front_max"] == pytest.approx(
         plain.summary["steps"][0]["probes"]["w_front_max"], rel=1e-12)
     assert plain.summary["steps"][1]["bisections"] == 0
@@ -268,10 +270,20 @@ def test_semismooth_contact_newton_equals_frozen_active_sets():
     assert semi.converged and frozen.converged
     for a, b in zip(semi.summary["steps"], frozen.summary["steps"]):
         assert a["debonded_area"] == b["debonded_area"]
-        assert a["probes"]["w_front_max"] == pytest.approx(b["probes"]["w_front_max"], rel=1e-7)
     assert semi.summary["debonded_area"][-1]["concrete/trc"] > 0
     its = [sum(s["iterations"] for s in r.summary["steps"]) for r in (semi, frozen)]
     assert its[0] <= its[1], its
+    # The same equilibrium: the two methods take different iteration paths, so each result is only
+    # as close to the equilibrium as the tolerance makes it (1e-8 on the residual, amplified by up
+    # to ~30 into a probe on these plates, tests/test_plate_gmsh.py). Solved to 1e-12 (with room
+    # for the extra contact iterations), they must agree to TIGHT_BOUND (measured here: 1e-14).
+    tight = {"n = 24": "factors = [0.5, 0.6, 0.7]\n" + TIGHT_STEPS}
+    semi = run_example("cantilever_plate_slip", tight)
+    frozen = run_example("cantilever_plate_slip", tight, newton={"semismooth_iterations": 0})
+    assert semi.converged and frozen.converged
+    for a, b in zip(semi.summary["steps"], frozen.summary["steps"]):
+        assert a["debonded_area"] == b["debonded_area"]
+        assert a["probes"]["w_front_max"] == pytest.approx(b["probes"]["w_front_max"], rel=TIGHT_BOUND)
 
 
 def test_contact_iteration_cap_from_the_model_file():
@@ -321,7 +333,9 @@ def test_without_reequilibration_releases_act_from_the_next_step():
     default re-solves it with the released strip (softer)."""
     from layershell.io.build import InputError, build, parse
 
-    steps = {"n = 24": "factors = [0.5, 0.55, 0.6]"}
+    # solved to 1e-12 so that "equal to the bonded plate's" can be checked at TIGHT_BOUND (the two
+    # models iterate differently: the delaminating one has contact blocks and a line search)
+    steps = {"n = 24": "factors = [0.5, 0.55, 0.6]\n" + TIGHT_STEPS}
     thesis = run_example("cantilever_plate_slip", {**steps, "[steps]": "[delamination]\nreequilibrate = false\n\n[steps]"})
     default = run_example("cantilever_plate_slip", steps)
     bonded = run_example("cantilever_plate_bonded", steps)
@@ -333,7 +347,7 @@ def test_without_reequilibration_releases_act_from_the_next_step():
     def w(r, i):
         return r.summary["steps"][i]["probes"]["w_front_max"]
 
-    assert w(thesis, 1) == pytest.approx(w(bonded, 1), rel=1e-9)  # λ = 0.55: released, not yet re-solved
+    assert w(thesis, 1) == pytest.approx(w(bonded, 1), rel=TIGHT_BOUND)  # λ = 0.55: released, not yet re-solved
     assert w(default, 1) > w(bonded, 1) * (1 + 1e-4)
     assert w(thesis, 2) > w(bonded, 2) * (1 + 1e-4)  # λ = 0.6 is solved with the released strip
     # step cutting measures the re-solutions, which this procedure has not: refused with a clear message

@@ -5,7 +5,7 @@ import json
 
 import numpy as np
 import pytest
-from helpers import EXAMPLES
+from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS
 
 from layershell.export import reference_displacement
 from layershell.io.build import build, parse
@@ -33,11 +33,12 @@ def _spec(twin: bool, extra: dict[str, str] | None = None):
     return build(parse(text, str(TOML)), EXAMPLES)
 
 
-def _match(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Index into ``b`` of the point equal to each point of ``a`` (both (n, 3))."""
+def _match(a: np.ndarray, b: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """Index into ``b`` of the point equal to each point of ``a`` (both (n, 3)) within ``tol``
+    (default: Gmsh writes 16 digits)."""
     d = np.linalg.norm(a[:, None] - b[None], axis=-1)
     idx = d.argmin(1)
-    assert np.allclose(d[np.arange(len(a)), idx], 0.0, atol=1e-9)  # Gmsh writes 16 digits
+    assert np.allclose(d[np.arange(len(a)), idx], 0.0, atol=tol)
     return idx
 
 
@@ -81,27 +82,116 @@ def test_model_from_groups_equals_model_from_formulas():
     assert fg == fr and len(fg) == 7
 
 
-@pytest.mark.slow  # the full example twice: about 35 s of CPU (longer on a busy machine)
-def test_gmsh_plate_solves_like_the_generated_plate(tmp_path):
-    """The whole example (8 nonlinear steps; the initial zone in contact from the start, new
-    debonding at λ = 0.5 and 0.875) and its generator/formula twin: the same probes, debonded
-    areas per step and nodal displacement field."""
-    rg = run(_spec(False), tmp_path / "g", write_vtu=False)
-    rr = run(_spec(True), None)
-    assert rg.converged and rr.converged
+#: Both runs are solved to 1e-12 instead of the example's 1e-8 (helpers.TIGHT_STEPS: at 1e-8 the
+#: two runs differ by up to 3.3e-7 in w_debonded, issue 16; at 1e-12 by 3e-12) and compared at
+#: BOUND = helpers.TIGHT_BOUND, which stays 100× below what a mis-read node, set or thickness
+#: does (test_the_comparison_detects_a_misread_mesh).
+TIGHT = {"[steps]\nn = 8": "[steps]\nn = 8\n" + TIGHT_STEPS}
+BOUND = TIGHT_BOUND
+#: The plate and its load are symmetric about x = 1.5, but the converged solution is not quite:
+#: which of two mirror-image states the release/friction decisions at symmetric points end in is
+#: decided by round-off (measured asymmetry |u(x) - M u(3 - x)| = 4.3e-7 m of |u| = 0.06 m; the
+#: Gmsh plate and the generator plate, whose nodes and elements are numbered differently, end in
+#: opposite mirror images on some machines). The fields are therefore compared after
+#: symmetrisation (½(u + M u), M the mirror x -> 3 - x), and each run's asymmetry is bounded by
+#: ASYMMETRY (1e-4 relative: a real modelling error, e.g. a wrong set, is far larger).
+ASYMMETRY = 1e-4
+
+
+def _mirror_mean(nodes: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, float]:
+    """½(u + M u) for the mirror M: x -> 3 - x (u_x changes sign), and max |u - M u|."""
+    xm = nodes.copy()
+    xm[:, 0] = 3.0 - xm[:, 0]
+    um = u[_match(xm, nodes, tol=0.01)] * np.array([-1.0, 1.0, 1.0])
+    return 0.5 * (u + um), float(np.abs(u - um).max())
+
+
+def _differences(rg, rr) -> dict[str, float]:
+    """Largest relative differences between two runs of the plate (g: any mesh, r: the generator
+    twin): every probe, the debonded area per step, and the symmetrised reference-face field."""
+    out = {}
     pg, pr = rg.summary["probes"], rr.summary["probes"]
-    assert pg["w_front_max"] > 0.05 and pg["w_debonded"] > 0.01
     for n in pr:
-        assert abs(pg[n] - pr[n]) <= 1e-7 * abs(pr[n]), n
-    ag = [a["concrete/trc"] for a in rg.summary["debonded_area"]]
-    ar = [a["concrete/trc"] for a in rr.summary["debonded_area"]]
-    assert ag == pytest.approx(ar, rel=1e-9)
-    assert ag[0] > 0 and ag[-1] > ag[0]  # open from the start, and it grows
-    assert rg.summary["first_delamination_load_factor"] == rr.summary["first_delamination_load_factor"]
+        out[n] = abs(pg[n] - pr[n]) / abs(pr[n])
+    ag = np.array([a["concrete/trc"] for a in rg.summary["debonded_area"]])
+    ar = np.array([a["concrete/trc"] for a in rr.summary["debonded_area"]])
+    out["debonded_area"] = float(np.abs(ag - ar).max() / ar.max()) if ag.shape == ar.shape else np.inf
+    xg, xr = rg.problem.model.mesh.nodes, rr.problem.model.mesh.nodes
     ug = reference_displacement(rg.problem.model, rg.problem.dm, rg.u)
     ur = reference_displacement(rr.problem.model, rr.problem.dm, rr.u)
-    node = _match(rg.problem.model.mesh.nodes, rr.problem.model.mesh.nodes)
-    np.testing.assert_allclose(ug, ur[node], rtol=0, atol=1e-7 * np.abs(ur).max())
+    sg, asym_g = _mirror_mean(xg, ug)
+    sr, asym_r = _mirror_mean(xr, ur)
+    scale = np.abs(ur).max()
+    node = _match(xg, xr, tol=0.01)  # the nearest node: a mis-read node must still be compared
+    out["field"] = float(np.abs(sg - sr[node]).max() / scale)
+    out["asymmetry"] = max(asym_g, asym_r) / scale
+    return out
+
+
+@pytest.fixture(scope="module")
+def twin_run():
+    """The generator/formula twin solved to the tight tolerance (shared by the tests below)."""
+    rr = run(_spec(True, TIGHT), None)
+    assert rr.converged
+    return rr
+
+
+@pytest.mark.slow  # the full example twice: about 10 s of CPU (longer on a busy machine)
+def test_gmsh_plate_solves_like_the_generated_plate(tmp_path, twin_run):
+    """The whole example (8 nonlinear steps; the initial zone in contact from the start, new
+    debonding at λ = 0.5 and 0.875) and its generator/formula twin: the same probes, debonded
+    areas per step and nodal displacement field, to the level the solver guarantees (BOUND)."""
+    rg, rr = run(_spec(False, TIGHT), tmp_path / "g", write_vtu=False), twin_run
+    assert rg.converged
+    pg = rg.summary["probes"]
+    assert pg["w_front_max"] > 0.05 and pg["w_debonded"] > 0.01
+    diff = _differences(rg, rr)
+    assert diff.pop("asymmetry") <= ASYMMETRY
+    for name, d in diff.items():
+        assert d <= BOUND, (name, d)
+    ag = [a["concrete/trc"] for a in rg.summary["debonded_area"]]
+    assert ag[0] > 0 and ag[-1] > ag[0]  # open from the start, and it grows
+    assert rg.summary["first_delamination_load_factor"] == rr.summary["first_delamination_load_factor"]
     s = json.loads((tmp_path / "g" / "summary.json").read_text())
     assert s["converged"] and len(s["steps"]) == 8
     assert (tmp_path / "g" / "debonded_zone_concrete_trc.png").is_file()
+
+
+def _misread(kind: str):
+    """read_mesh with one deliberate reader error: a node 0.1 mm off, a node missing from the
+    clamp group."""
+    from layershell.io import meshfile
+
+    real = meshfile.read_mesh
+
+    def read(path, scale=1.0):
+        m = real(path, scale)
+        if kind == "node":  # the centre node at (2.5, 2.5) read 0.1 mm off in x
+            (k,) = np.flatnonzero(np.linalg.norm(m.nodes - [2.5, 2.5, 0.0], axis=1) < 1e-9)
+            m.nodes[k, 0] += 1e-4
+        elif kind == "set":  # one clamp node (not a corner) dropped from its group
+            clamp = m.node_sets["clamp"]
+            m.node_sets["clamp"] = clamp[np.abs(m.nodes[clamp, 0] - 1.5) > 1e-9]
+        return m
+
+    return read
+
+
+@pytest.mark.slow  # three more runs of the example: about 15 s of CPU
+@pytest.mark.parametrize("kind", ["node", "set", "thickness"])
+def test_the_comparison_detects_a_misread_mesh(kind, monkeypatch, twin_run):
+    """The equivalence test can fail: a node read 0.1 mm off, a node missing from a group, or the
+    TRC thickness 0.1 % off at one node (what a thickness formula gives at a mis-read node) each
+    puts some compared quantity at least 100 × BOUND away from the twin."""
+    from layershell.io import meshfile
+
+    extra = dict(TIGHT)
+    if kind == "thickness":
+        extra['name = "trc"\nmaterial = "trc"\nthickness = 0.01'] = (
+            'name = "trc"\nmaterial = "trc"\nthickness = "0.01001 if near(x, 1.5) and near(y, 1.5) else 0.01"')
+    else:
+        monkeypatch.setattr(meshfile, "read_mesh", _misread(kind))
+    rg = run(_spec(False, extra), None)
+    assert rg.converged
+    diff = _differences(rg, twin_run)
+    assert max(diff.values()) > 100 * BOUND, diff

@@ -208,5 +208,50 @@ def build_operator(n_full: int, rows: _Rows) -> ConstraintOperator:
     return ConstraintOperator(T, indep, fixed)
 
 
+def apply_ties(op: ConstraintOperator, model: Model, dm: DofMap) -> ConstraintOperator:
+    """Supports on a face, at a height or on a director of any layer (:class:`~layershell.model.Tie`):
+    each row c·u = 0 is written in the reduced DOFs of ``op`` (c_r = c T, so a bond or hinge is
+    respected) and the reduced DOF with the largest |c_r| is eliminated, u_p = -Σ c_r,j/c_r,p u_j.
+    Rows of one tie and component belong to distinct nodes and so to distinct reduced DOFs
+    (all relations are node-local), which lets a whole batch be eliminated at once; a row that
+    is already satisfied (c_r = 0, e.g. on a fixed DOF) is skipped."""
+    T, indep = op.T, op.independent
+    for tie in model.ties:
+        present = dm.present[tie.layer][tie.nodes]
+        nodes, coeffs, dirs = tie.nodes[present], tie.coeffs[present], tie.direction[present]
+        if nodes.size == 0:
+            continue
+        D = dm.layer_dofs[tie.layer][nodes]  # (m, d+1, 3)
+        m = nodes.size
+        rows = np.repeat(np.arange(m), D.shape[1] * 3)
+        vals = (coeffs[:, :, None] * dirs[:, None, :]).ravel()
+        C = sp.csr_matrix((vals, (rows, D.ravel())), shape=(m, T.shape[0]))
+        Cr = (C @ T).tocsr()
+        Cr.eliminate_zeros()
+        scale = np.abs(vals).reshape(m, -1).max(1)
+        A = abs(Cr)
+        piv = np.asarray(A.argmax(axis=1)).ravel()
+        pv = np.asarray(Cr[np.arange(m), piv]).ravel()
+        ok = np.abs(pv) > 1e-12 * scale
+        if not ok.any():
+            continue
+        Cr, piv, pv = Cr[np.flatnonzero(ok)], piv[ok], pv[ok]
+        if np.unique(piv).size != piv.size:
+            raise ConstraintError("two supports of one table act on the same degree of freedom; select each node "
+                                  "once")
+        S = sp.diags(1.0 / pv) @ Cr  # rows: u_p + Σ_j S_j u_j = 0
+        n_red = T.shape[1]
+        P = sp.csr_matrix((np.ones(piv.size), (piv, np.arange(piv.size))), shape=(n_red, piv.size))
+        E = sp.identity(n_red, format="csr") - P @ S
+        keep = np.ones(n_red, bool)
+        keep[piv] = False
+        T = (T @ E).tocsr()[:, np.flatnonzero(keep)]
+        T.eliminate_zeros()
+        T.sort_indices()
+        indep = indep[keep]
+    return ConstraintOperator(T.tocsr(), indep, op.fixed)
+
+
 def constraint_operator(model: Model, dm: DofMap, bonded=None) -> ConstraintOperator:
-    return build_operator(dm.n_full, collect(model, dm, bonded))
+    op = build_operator(dm.n_full, collect(model, dm, bonded))
+    return apply_ties(op, model, dm) if getattr(model, "ties", None) else op

@@ -2,7 +2,8 @@
 
 Every load is reduced to director forces per layer, F_(a,l,L) = ∫ (Θ_L³)^l F_a dΘ_L³ (2.168),
 (3.37), and integrated over the element with the shape functions (2.256)-(2.258). As in the
-thesis the shifter μ is neglected in the through-thickness integrals (A5).
+thesis the shifter μ is neglected in the through-thickness integrals (A5), except for volume
+(gravity) loads, which are integrated over the true volume with μ.
 """
 from __future__ import annotations
 
@@ -46,6 +47,19 @@ def director_vector_volume(H: np.ndarray, d: int) -> np.ndarray:
     H = np.asarray(H, float)[..., None]
     l = np.arange(d + 1)
     return H ** (l + 1) / (l + 1)
+
+
+def director_vector_volume_shifted(off: np.ndarray, H: np.ndarray, trB: np.ndarray, detB: np.ndarray,
+                                   d: int) -> np.ndarray:
+    """(…, d+1) factors ∫_0^H (Θ_L)^l μ(off + Θ_L) dΘ_L of a constant volume load with the
+    shifter μ(Θ³) = det(δ − Θ³ B) = 1 − Θ³ tr B + (Θ³)² det B ((2.31), (2.183) without the
+    thesis's μ ≈ 1): the load per reference area is that of the true volume (exact, Gauss)."""
+    t, w = gauss_1d(d // 2 + 3)
+    H = np.asarray(H, float)[..., None]
+    th = 0.5 * H * (t + 1.0)  # (…, g)
+    z = np.asarray(off, float)[..., None] + th
+    mu = 1.0 - z * np.asarray(trB)[..., None] + z**2 * np.asarray(detB)[..., None]
+    return np.einsum("...g,...gl->...l", 0.5 * H * w * mu, th[..., None] ** np.arange(d + 1))
 
 
 def director_forces_distribution(fn, offset, H, d: int, n_gauss: int = 12, **xyz) -> np.ndarray:
@@ -97,8 +111,11 @@ def surface_load_vector(model: Model, dm: DofMap, load: SurfaceLoad, F: np.ndarr
         dA = sp.sqrtA * w  # (e, q)
         if load.face == "volume":
             targets = [k for k in stack if load.layer is None or k == load.layer]
-            facs = [director_vector_volume(sp.interpolate(model.layers[k].thickness[conn]), model.layers[k].directors)
-                    for k in targets]
+            trB = np.trace(sp.Bmix, axis1=-2, axis2=-1)
+            detB = np.linalg.det(sp.Bmix)
+            facs = [director_vector_volume_shifted(sp.interpolate(model.offset(k)[conn]),
+                                                   sp.interpolate(model.layers[k].thickness[conn]), trB, detB,
+                                                   model.layers[k].directors) for k in targets]
         else:
             k, kind = _face_layer(model, stack, load.face)
             targets = [k]
@@ -136,11 +153,23 @@ def edge_load_vector(model: Model, dm: DofMap, load: EdgeLoad, F: np.ndarray, lo
         X = mesh.nodes[tri]  # (3, 3)
         xs = N @ X
         ds = np.linalg.norm(dN @ X, axis=1) * w  # (g,)
+        at = None
+        if load.at_height is not None:  # the layer containing the height (from the top: the upper at an interface)
+            tol = 1e-9 * max(float(model.total_thickness()[tri].max()), 1e-300)
+            at = next((k for k in stack[::-1] if np.all(model.offset(k)[tri] <= load.at_height + tol)), None)
+            if at is None or np.any(model.offset(at)[tri] + model.layers[at].thickness[tri] < load.at_height - tol):
+                raise LoadError(f"edge load at Θ³ = {load.at_height:g}: outside the shell at edge {key}")
         for k in stack:
             ly = model.layers[k]
             off = N @ model.offset(k)[tri]
             H = N @ ly.thickness[tri]
-            if load.at_face is not None:  # line force on a face: (2.175) / (2.180)
+            if at is not None:  # line force at a height: director forces (Θ_L³)^l q
+                if k != at:
+                    continue
+                mag = np.broadcast_to(load.distribution(theta3=np.full(H.shape, load.at_height), x=xs[:, 0],
+                                                        y=xs[:, 1], z=xs[:, 2]), H.shape)
+                q = (load.at_height - off)[:, None] ** np.arange(ly.directors + 1) * mag[:, None]
+            elif load.at_face is not None:  # line force on a face: (2.175) / (2.180)
                 if k != (stack[-1] if load.at_face == "top" else stack[0]):
                     continue
                 mag = np.broadcast_to(load.distribution(theta3=off, x=xs[:, 0], y=xs[:, 1], z=xs[:, 2]), H.shape)

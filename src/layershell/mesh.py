@@ -195,12 +195,31 @@ def _orient(mesh: Mesh, normal_fn) -> Mesh:
     return mesh
 
 
-def rectangle(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0, 0.0), normal: str = "+z") -> Mesh:
+def graded(n: int, ratio: float = 1.0) -> np.ndarray:
+    """The 2n+1 node coordinates in [0, 1] of n elements whose sizes grow geometrically from the
+    first to the last by ``ratio`` (last/first); mid-side nodes at the element midpoints."""
+    q = ratio ** (1.0 / (n - 1)) if n > 1 else 1.0
+    h = q ** np.arange(n)
+    c = np.concatenate([[0.0], np.cumsum(h)]) / h.sum()
+    out = np.empty(2 * n + 1)
+    out[0::2] = c
+    out[1::2] = 0.5 * (c[:-1] + c[1:])
+    return out
+
+
+def rectangle(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0, 0.0), normal: str = "+z",
+              grading_x: float = 1.0, grading_y: float = 1.0) -> Mesh:
     """Flat rectangular plate in the x-y plane; ``normal`` '+z' (reference face at the bottom)
-    or '-z' (reference face on top, material below)."""
+    or '-z' (reference face on top, material below). ``grading_x``/``grading_y``: size of the
+    last element over the first along x/y (geometric; < 1 refines towards the far edge)."""
     o = np.asarray(origin, float)
-    mesh = _structured(nx, ny, lambda s, t: np.stack([o[0] + lx * s, o[1] + ly * t, o[2] + 0 * s], -1),
-                       ("xmin", "xmax", "ymin", "ymax"))
+    gx, gy = graded(nx, grading_x), graded(ny, grading_y)
+
+    def fn(s, t):
+        i, j = np.rint(s * 2 * nx).astype(int), np.rint(t * 2 * ny).astype(int)
+        return np.stack([o[0] + lx * gx[i], o[1] + ly * gy[j], o[2] + 0 * s], -1)
+
+    mesh = _structured(nx, ny, fn, ("xmin", "xmax", "ymin", "ymax"))
     sign = -1.0 if normal.strip().startswith("-") else 1.0
     return _orient(mesh, lambda c: np.tile([0.0, 0.0, sign], (len(c), 1)))
 

@@ -38,6 +38,19 @@ class Fix:
 
 
 @dataclass(frozen=True)
+class Tie:
+    """Linear support of layer ``layer`` at ``nodes``: Σ_l c_l u_l · n = 0 per node, with
+    ``coeffs (n_sel, d+1)`` (a face or height Θ_L³: c_l = (Θ_L³)^l, MODEL.md §2; one director:
+    a unit vector) and unit ``direction (n_sel, 3)``. Applied after the bond, so a support on
+    the bottom face of a bonded upper layer acts on the top face of the layer below."""
+
+    nodes: np.ndarray
+    layer: int
+    coeffs: np.ndarray
+    direction: np.ndarray
+
+
+@dataclass(frozen=True)
 class Symmetry:
     """Symmetry plane with unit normal ``normal``: u_l · n = 0 for every director of every layer."""
 
@@ -96,6 +109,7 @@ class EdgeLoad:
     distribution: object
     scaled: bool = True
     at_face: str | None = None  # 'top' | 'reference': a line force per edge length on that face (2.180)
+    at_height: float | None = None  # a line force per edge length at this Θ_1³
 
 
 @dataclass
@@ -107,6 +121,7 @@ class Model:
     fixes: list[Fix] = field(default_factory=list)
     symmetries: list[Symmetry] = field(default_factory=list)
     hinges: list[Hinge] = field(default_factory=list)
+    ties: list[Tie] = field(default_factory=list)
     nodal_loads: list[NodalLoad] = field(default_factory=list)
     surface_loads: list[SurfaceLoad] = field(default_factory=list)
     edge_loads: list[EdgeLoad] = field(default_factory=list)

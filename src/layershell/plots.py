@@ -42,8 +42,31 @@ def _save(fig, path) -> Path:
     return path
 
 
-def plot_load_displacement(path, load_factors, probes: dict[str, list[float]], units: str = "") -> Path:
-    """Load-displacement curves: one subplot per probe, probe value on x, load factor on y."""
+def plot_xy(path, x: tuple[str, list[float]], y: tuple[str, list[float]], title: str = "") -> Path:
+    """One curve of probe y against probe x over the converged steps (axis labels given)."""
+    fig = _figure((5.0, 3.8))
+    ax = fig.subplots()
+    xv, yv = np.asarray(x[1], float), np.asarray(y[1], float)
+    m = min(xv.size, yv.size)
+    ax.plot(xv[:m], yv[:m], "o-", ms=3, lw=1.2)
+    ax.set_xlabel(x[0])
+    ax.set_ylabel(y[0])
+    ax.set_title(title)
+    ax.grid(True, alpha=0.4)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def _label(name: str, unit: str | None, units: str) -> str:
+    u = unit if unit is not None else units
+    return f"{name} [{u}]" if u else name
+
+
+def plot_load_displacement(path, load_factors, probes: dict[str, list[float]], units: str = "",
+                           probe_units: dict[str, str | None] | None = None) -> Path:
+    """Load-displacement curves: one subplot per probe, probe value on x, load factor on y;
+    axes labelled with the probe's own unit where given (else the unit system)."""
+    probe_units = probe_units or {}
     lam = np.asarray(load_factors, float)
     n = max(len(probes), 1)
     ncols = min(n, 3)
@@ -54,7 +77,7 @@ def plot_load_displacement(path, load_factors, probes: dict[str, list[float]], u
         v = np.asarray(values, float)
         m = min(v.size, lam.size)
         ax.plot(v[:m], lam[:m], "o-", ms=3, lw=1.2)
-        ax.set_xlabel(f"{name} [{units}]" if units else name)
+        ax.set_xlabel(_label(name, probe_units.get(name), units))
         ax.set_ylabel("load factor")
         ax.set_title(name)
         ax.grid(True, alpha=0.4)
@@ -278,8 +301,10 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
                   through_thickness=None) -> dict:
     """All PNG figures of a run, written into ``out`` (called once after the last step).
 
-    - ``load_displacement.png`` (every probe) and ``load_displacement_<probe>.png`` (one each):
-      load factor against the probe value per converged step;
+    - ``load_displacement.png`` (every probe but load_factor ones) and
+      ``load_displacement_<probe>.png`` (one each): load factor against the probe value per
+      converged step, each axis in the probe's ``unit``;
+    - ``plot_<name>.png`` for every ``[[plots]]``: probe y against probe x;
     - ``deformed.png``: the deformed reference surface coloured by |u| (last converged step);
     - ``thickness_<probe>.png``: for every stress probe at a ``point``, its component through
       all layers at that point (last converged step), the probe's own Θ³ marked;
@@ -298,15 +323,23 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
     if not steps:
         return files
     lam = [s["load_factor"] for s in steps]
-    names = [p.name for p in spec.probes]
+    names = [p.name for p in spec.probes if p.quantity != "load_factor"]  # λ against λ: a straight line
+    units_of = {p.name: getattr(p, "unit", None) for p in spec.probes}
     if names:
         series = {n: [s["probes"][n] for s in steps] for n in names}
-        plot_load_displacement(out / "load_displacement.png", lam, series, model.units)
+        plot_load_displacement(out / "load_displacement.png", lam, series, model.units, units_of)
         files["load_displacement.png"] = {"probes": names}
         for n in names:
             f = f"load_displacement_{_safe(n)}.png"
-            plot_load_displacement(out / f, lam, {n: series[n]}, model.units)
+            plot_load_displacement(out / f, lam, {n: series[n]}, model.units, units_of)
             files[f] = {"probe": n, "range": (float(min(series[n])), float(max(series[n])))}
+    for pl in getattr(spec.source, "plots", []):
+        xs, ys = ([s["probes"][n] for s in steps] for n in (pl.x, pl.y))
+        f = f"plot_{_safe(pl.name)}.png"
+        plot_xy(out / f, (_label(pl.x, units_of.get(pl.x), model.units), xs),
+                (_label(pl.y, units_of.get(pl.y), model.units), ys), pl.title or f"{pl.y} against {pl.x}")
+        files[f] = {"x": pl.x, "y": pl.y, "range_x": (float(min(xs)), float(max(xs))),
+                    "range_y": (float(min(ys)), float(max(ys)))}
 
     files["deformed.png"] = plot_deformed(out / "deformed.png", model, problem.dm, u, info=True)[1]
 

@@ -114,6 +114,26 @@ def _model_file(folder: Path, summary: dict, model: str | Path | None) -> str:
     return str(tomls[0]) if tomls else "not recorded in the results folder (give --model)"
 
 
+def _section_model_text(folder: Path, summary: dict, model: str | Path | None) -> str:
+    """The model file's text: as run (``model_text`` in summary.json), else the file named by
+    ``--model`` or summary.json as it is now (noted when it is newer than the results)."""
+    text, note = summary.get("model_text"), ""
+    if not isinstance(text, str):
+        name = model if model is not None else summary.get("model_file")
+        path = Path(name) if isinstance(name, (str, Path)) else None
+        if path is None or not path.is_file():
+            return ""
+        try:
+            text = path.read_text(encoding="utf-8")
+        except (OSError, UnicodeDecodeError):
+            return ""
+        res = folder / "summary.json"
+        if res.is_file() and path.stat().st_mtime > res.stat().st_mtime:
+            note = f'<p class="note">read from {_esc(path)} now; it was changed after the results were written</p>'
+    return (f'<h2>Model file</h2>{note}<details><summary>model file text</summary>'
+            f'<pre id="model-text">{_esc(text)}</pre></details>')
+
+
 def _utc(ts: float) -> str:
     return dt.datetime.fromtimestamp(ts, dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
 
@@ -155,7 +175,7 @@ def render(folder: str | Path, model: str | Path | None = None) -> str:
     if summary.get("steps") or probes_csv:
         parts.append(_section_steps(summary, probes_csv))
     parts.append(_section_figures(folder))
-    for extra in (_section_profiles(folder), _section_sweep(folder), _section_calibration(folder),
+    for extra in (_section_model_text(folder, summary, model), _section_profiles(folder), _section_sweep(folder), _section_calibration(folder),
                   _section_files(folder)):
         if extra:
             parts.append(extra)

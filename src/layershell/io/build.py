@@ -24,7 +24,7 @@ from .. import mesh as meshmod
 from ..element.shape import EDGES
 from ..formula import FormulaError
 from ..material import MaterialError, Orthotropic
-from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry, Tie
 from ..solver.newton import NewtonSettings
 from . import schema
 from .errors import XYZ, InputError  # defined apart: io/probes.py needs them without importing this module
@@ -298,6 +298,19 @@ def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
     return el
 
 
+def nodal_normals(m: meshmod.Mesh) -> np.ndarray:
+    """(n_nodes, 3) unit normals A3 at the nodes, averaged over the elements sharing each node."""
+    from ..element.geometry import surface_points
+    from ..element.shape import NODE_XI
+
+    E = m.elements
+    sp = surface_points(m.nodes[E], np.broadcast_to(NODE_XI[:, 0], E.shape), np.broadcast_to(NODE_XI[:, 1], E.shape),
+                        per_element=True)
+    acc = np.zeros((m.n_nodes, 3))
+    np.add.at(acc, E.ravel(), sp.A3.reshape(-1, 3))
+    return acc / np.linalg.norm(acc, axis=1, keepdims=True)
+
+
 def boundary_edges(m: meshmod.Mesh) -> np.ndarray:
     """(n, 3) node triples of edges that belong to one element only."""
     tri = m.elements[:, EDGES].reshape(-1, 3)
@@ -329,7 +342,7 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
         raise InputError(f"'mesh': {size[1]} = {size[0]} elements is more than layershell can handle (at most "
                          f"{MAX_ELEMENTS}); use fewer elements")
     if md.type == "rectangle":
-        return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal)
+        return meshmod.rectangle(md.lx, md.ly, md.nx, md.ny, md.origin, md.normal, md.grading_x, md.grading_y)
     if md.type == "cylinder":
         return meshmod.cylinder(md.radius, md.angle_start, md.angle_end, md.width, md.n_arc, md.n_width,
                                 md.normal, md.axis)
@@ -443,6 +456,119 @@ def _edge_normals(m: meshmod.Mesh, nodes: np.ndarray, field: str) -> np.ndarray:
         raise InputError(f"'{field}.direction': 'edge-normal' needs nodes on the mesh boundary; "
                          f"{int((~found).sum())} selected node(s) are not on a boundary edge")
     return out
+
+
+def _heights(model: Model, nodes: np.ndarray, height: float | None, face: str | None, k_given: int | None,
+             f: str, index: dict) -> list[tuple[int, np.ndarray, np.ndarray]]:
+    """Where a force at Θ³ = ``height`` or on ``face`` acts: ``(layer, mask of nodes, Θ_L³)``
+    per layer (the layer containing the height; the upper one at an interface)."""
+    layers = model.layers
+    tol = 1e-9 * model.mesh.size()
+    present = np.zeros((len(layers), nodes.size), bool)
+    for si, st in enumerate(model.stacks):
+        on = np.zeros(model.mesh.n_nodes, bool)
+        on[np.unique(model.mesh.elements[model.element_stack == si])] = True
+        for k in st:
+            present[k] |= on[nodes]
+    if face is not None:
+        if face == "reference":
+            h = np.zeros(nodes.size)
+        elif face == "top":
+            h = model.total_thickness()[nodes]
+        elif face.startswith("layer:") and face.split(":", 1)[1] in index:
+            k_given = index[face.split(":", 1)[1]]
+            h = model.offset(k_given)[nodes]
+        else:
+            raise InputError(f"'{f}.face': unknown face '{face}'; use 'reference', 'top' or 'layer:<name>' with a "
+                             f"layer of {list(index)}")
+    else:
+        h = np.full(nodes.size, float(height))
+    out, done = [], np.zeros(nodes.size, bool)
+    order = [k_given] if k_given is not None else sorted(range(len(layers)), key=lambda j: -model.offset(j)[nodes].max())
+    for k in order:
+        off = model.offset(k)[nodes]
+        inside = present[k] & ~done & (off - tol <= h) & (h <= off + layers[k].thickness[nodes] + tol)
+        if inside.any():
+            out.append((k, inside, np.clip(h - off, 0.0, None)[inside]))
+            done |= inside
+    if not done.all():
+        bad = int(np.flatnonzero(~done)[0])
+        raise InputError(f"'{f}': Θ³ = {h[bad]:g} lies outside "
+                         + (f"layer '{layers[k_given].name}'" if k_given is not None else "the shell")
+                         + f" at node {nodes[bad]} (total thickness {model.total_thickness()[nodes[bad]]:.6g}); give a "
+                         "height inside the shell")
+    return out
+
+
+def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) -> list[Tie]:
+    """A fix on a face, at a height, in a direction or through all layers (``layer = 'all'``) as
+    linear supports Σ_l c_l u_l · e = 0 (see :func:`layershell.constraints.apply_ties`)."""
+    layers = model.layers
+    if sd.direction is not None and "components" in sd.model_fields_set:
+        raise InputError(f"'{f}': give 'direction' (one held direction) or 'components' (global x, y, z), not both")
+    if sd.direction is not None:
+        dirs = [_vec(sd.direction, f + ".direction")]
+    else:
+        if not sd.components:
+            raise InputError(f"'{f}.components': give at least one of 'x', 'y', 'z' (or a 'direction')")
+        dirs = [np.eye(3)["xyz".index(c)] for c in dict.fromkeys(sd.components)]
+    placed = sd.face is not None or sd.height is not None
+    if placed and sd.directors != [0]:
+        raise InputError(f"'{f}.directors': a support on a face or at a height holds the displacement there; "
+                         "remove 'directors'")
+    if sd.face is not None and sd.height is not None:
+        raise InputError(f"'{f}': give 'face' or 'height', not both")
+    out = []
+    if sd.layer == "all":
+        if placed:
+            raise InputError(f"'{f}': layer = 'all' holds the layers' director vectors through the whole thickness; "
+                             "remove 'face'/'height' or name one layer")
+        for k, ly in enumerate(layers):
+            dirs_k = range(ly.directors + 1) if sd.directors == "all" else sd.directors
+            if any(l > ly.directors or l < 0 for l in dirs_k):
+                raise InputError(f"'{f}.directors': layer '{ly.name}' has directors 0..{ly.directors}, got "
+                                 f"{list(dirs_k)}")
+            for l in dirs_k:
+                c = np.zeros((nodes.size, ly.directors + 1))
+                c[:, l] = 1.0
+                out += [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for e in dirs]
+        return out
+    if sd.layer is not None and sd.layer not in index:
+        raise InputError(f"'{f}.layer': unknown layer '{sd.layer}'; defined: {list(index)} (or 'all')")
+    k = index.get(sd.layer, first) if sd.layer is not None else None
+    if sd.height is not None:
+        h = float(sd.height)
+        if k is None:  # the layer containing the height at the nodes (the upper one at an interface)
+            cands = [j for j in range(len(layers))
+                     if np.all((model.offset(j)[nodes] <= h + 1e-9 * model.mesh.size())
+                               & (h <= (model.offset(j) + layers[j].thickness)[nodes] + 1e-9 * model.mesh.size()))]
+            if not cands:
+                raise InputError(f"'{f}.height': no layer contains Θ³ = {h:g} at all selected nodes (total thickness "
+                                 f"{model.total_thickness()[nodes].min():.6g} to "
+                                 f"{model.total_thickness()[nodes].max():.6g}); give a height inside the shell or "
+                                 "name the 'layer'")
+            k = max(cands, key=lambda j: model.offset(j)[nodes].mean())
+        theta = h - model.offset(k)[nodes]
+        H = layers[k].thickness[nodes]
+        if np.any(theta < -1e-9 * model.mesh.size()) or np.any(theta > H + 1e-9 * model.mesh.size()):
+            raise InputError(f"'{f}.height': Θ³ = {h:g} lies outside layer '{layers[k].name}' at some selected nodes; "
+                             "give a height inside the layer or leave 'layer' out")
+    else:
+        k = first if k is None else k
+        theta = (layers[k].thickness[nodes] if sd.face == "top" else np.zeros(nodes.size))
+    if sd.directors != [0] and not placed:
+        d = layers[k].directors
+        dl = range(d + 1) if sd.directors == "all" else sd.directors
+        if any(l > d or l < 0 for l in dl):
+            raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dl)}")
+        cs = []
+        for l in dl:
+            c = np.zeros((nodes.size, d + 1))
+            c[:, l] = 1.0
+            cs.append(c)
+    else:
+        cs = [theta[:, None] ** np.arange(layers[k].directors + 1)]
+    return [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for c in cs for e in dirs]
 
 
 def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
@@ -567,6 +693,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
     first = stacks[0][0]
+    if mf.mesh.surface == "middle":
+        m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)
 
     # supports
     if not mf.supports:
@@ -576,7 +704,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     for i, sd in enumerate(mf.supports):
         f = f"supports[{i}]"
         nodes = _node_selection(m, sd, f)
-        if sd.type == "fix":
+        if sd.type == "fix" and (sd.layer == "all" and "all" not in index or sd.face is not None
+                                 or sd.height is not None or sd.direction is not None):
+            model.ties.extend(_ties(model, sd, nodes, f, index, first))
+        elif sd.type == "fix":
             k = layer_idx(sd.layer, f + ".layer")
             k = first if k is None else k
             d = layers[k].directors
@@ -648,9 +779,23 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                 _require_finite(_nodal_values(m, ld.distribution, f + ".distribution", pts, t=t),
                                 ld.distribution, f + ".distribution", "point of the loaded edges (t inside the "
                                 "thickness)")
+            if ld.height is not None and ld.face is not None:
+                raise InputError(f"'{f}': give 'face' or 'height' for a line force, not both")
             model.edge_loads.append(EdgeLoad(edges, _vec(ld.direction, f + ".direction"),
                                              lambda theta3, dist=dist, **kw: dist(t=theta3, **kw), ld.scaled,
-                                             at_face=ld.face))
+                                             at_face=ld.face, at_height=ld.height))
+        elif ld.height is not None or ld.face is not None:  # nodal force at a height / on a face
+            nodes = _node_selection(m, ld, f)
+            if ld.director != 0:
+                raise InputError(f"'{f}.director': a force at a height or on a face is split into director forces "
+                                 "automatically; remove 'director'")
+            if ld.height is not None and ld.face is not None:
+                raise InputError(f"'{f}': give 'face' or 'height', not both")
+            k_given = layer_idx(ld.layer, f + ".layer")
+            for k, sel, th in _heights(model, nodes, ld.height, ld.face, k_given, f, index):
+                fl = np.asarray(ld.value, float)
+                for l in range(layers[k].directors + 1):
+                    model.nodal_loads.append(NodalLoad(nodes[sel], k, l, th[:, None] ** l * fl, ld.scaled))
         else:  # nodal
             nodes = _node_selection(m, ld, f)
             k = layer_idx(ld.layer, f + ".layer")

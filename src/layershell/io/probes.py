@@ -32,6 +32,11 @@ class Probe:
     reduce: str
     scale: float
     where: Callable | None = None  # debonded_area: selection of interface points (x, y, z)
+    nodes: np.ndarray | None = None  # reaction: the support nodes
+    direction: np.ndarray | None = None  # resultant: normal of the section
+    about: float | None = None  # resultant: Θ³ of the moment axis (None: mid-height of the stack)
+    unit: str | None = None  # label of the value on plot axes
+    _cache: dict | None = None
 
     def points(self, model, dm, u) -> PointState:
         layers = None if self.layer is None else np.full(self.elements.size, self.layer)
@@ -72,8 +77,93 @@ class Probe:
             area += float((blk.w0 * counted).sum())
         return area
 
-    def value(self, model, dm, u, load_factor: float = 0.0, interfaces=None) -> float:
+    # ------------------------------------------------------------ reaction
+    def rigid_mode(self, model, dm) -> np.ndarray:
+        """Full-space virtual displacement of the support nodes only: a rigid translation
+        (component x|y|z) or rotation about the global axis through the origin (mx|my|mz) of
+        every layer at those nodes: u_0L = e (× X_L), u_1L = e × A3 (rotation), higher
+        directors 0 (MODEL.md (3.40)). Zero at all other nodes, so ρ·(f_int − F_ext) is the
+        virtual work of the support forces at the nodes: bonds (satisfied by a rigid motion)
+        and interface forces (equal and opposite at a node) drop out."""
+        c = self.component
+        e = np.eye(3)["xyz".index(c[-1])]
+        rho = np.zeros(dm.n_full)
+        nodes = self.nodes
+        X = model.mesh.nodes[nodes]
+        A3 = _nodal_normals(model)[nodes] if c.startswith("m") else None
+        for k, ly in enumerate(model.layers):
+            sel = dm.present[k][nodes]
+            if not sel.any():
+                continue
+            D = dm.layer_dofs[k][nodes[sel]]
+            if c.startswith("m"):
+                Xk = X[sel] + model.offset(k)[nodes[sel], None] * A3[sel]
+                rho[D[:, 0, :]] = np.cross(e, Xk)
+                if ly.directors >= 1:
+                    rho[D[:, 1, :]] = np.cross(e, A3[sel])
+            else:
+                rho[D[:, 0, :]] = e
+        return rho
+
+    def reaction(self, model, dm, u, load_factor: float, problem=None) -> float:
+        """Support force/moment at the nodes: ρ·(f_int(u) − F_ext(λ)) (the force the supports
+        exert on the shell; with a ``problem`` its assembler, contact blocks and friction loads)."""
+        if self._cache is None or self._cache.get("model") is not model:
+            self._cache = {"model": model, "rho": self.rigid_mode(model, dm)}
+        return float(self._cache["rho"] @ residual_forces(model, dm, u, load_factor, problem))
+
+    # ------------------------------------------------------------ stress resultant
+    def resultant(self, model, dm, u, n_gauss: int = 8) -> float:
+        """Stress resultant per unit width at the probe's point: with e1 the section normal
+        (``direction`` projected on the tangent plane), e3 = A3, e2 = e3 × e1:
+        n = ∫ e1·σ·e1 dΘ³, m = ∫ e1·σ·e1 (Θ³ − Θ_m) dΘ³, q = ∫ e1·σ·e3 dΘ³, nt, mt with e2
+        for the second index; Cauchy stresses, through all layers of the stack (Gauss points
+        per layer), without the shifter (per unit width of the reference surface). A point on
+        element boundaries gets the mean over the elements that share it (the stresses of the
+        displacement element jump there)."""
+
+        vals = [self._resultant_at(model, dm, u, int(e), float(x), float(y), n_gauss)
+                for e, x, y in zip(self.elements, self.xi, self.eta)]
+        return float(np.mean(vals))
+
+    def _resultant_at(self, model, dm, u, e: int, xi: float, eta: float, n_gauss: int) -> float:
+        from ..element.geometry import surface_points
+        from ..element.quadrature import gauss_1d
+
+        stack = model.stacks[model.element_stack[e]]
+        conn = model.mesh.elements[e]
+        sp = surface_points(model.mesh.nodes[conn][None], np.array([[xi]]), np.array([[eta]]), per_element=True)
+        t, w = gauss_1d(n_gauss)
+        th, wt, lay = [], [], []
+        for k in stack:
+            off = float(sp.interpolate(model.offset(k)[conn][None])[0, 0])
+            H = float(sp.interpolate(model.layers[k].thickness[conn][None])[0, 0])
+            th.append(off + 0.5 * H * (t + 1.0))
+            wt.append(0.5 * H * w)
+            lay.append(np.full(t.size, k))
+        th, wt, lay = np.concatenate(th), np.concatenate(wt), np.concatenate(lay)
+        p = th.size
+        ps = evaluate_points(model, dm, u, np.full(p, e), np.full(p, xi), np.full(p, eta), th, lay)
+        n3 = sp.A3[0, 0]
+        d = self.direction - (self.direction @ n3) * n3
+        e1 = d / np.linalg.norm(d)
+        e2 = np.cross(n3, e1)
+        s11 = np.einsum("i,pij,j->p", e1, ps.sigma, e1)
+        s12 = np.einsum("i,pij,j->p", e1, ps.sigma, e2)
+        s13 = np.einsum("i,pij,j->p", e1, ps.sigma, n3)
+        top = float(sum(wt))
+        zm = 0.5 * top if self.about is None else float(self.about)
+        c = self.component
+        arm = th - zm
+        val = {"n": wt @ s11, "m": wt @ (s11 * arm), "q": wt @ s13, "nt": wt @ s12, "mt": wt @ (s12 * arm)}[c]
+        return float(val)
+
+    def value(self, model, dm, u, load_factor: float = 0.0, interfaces=None, problem=None) -> float:
         """The probe's value at displacements ``u`` (full vector), load factor and interface states."""
+        if self.quantity == "reaction":
+            return self.scale * self.reaction(model, dm, u, load_factor, problem)
+        if self.quantity == "resultant":
+            return self.scale * self.resultant(model, dm, u)
         if self.quantity == "load_factor":
             return self.scale * float(load_factor)
         if self.quantity == "debonded_area":
@@ -88,6 +178,40 @@ class Probe:
         if self.reduce == "mean":
             return float(v.mean())
         return float(v[0])
+
+
+def residual_forces(model, dm, u: np.ndarray, load_factor: float, problem=None) -> np.ndarray:
+    """f_int(u) − F_ext(λ) in the full space: the forces of the constraints (supports, bonds)
+    on the shell. Without a ``problem``, an assembler of the bare elements is kept on the model
+    (contact and friction forces between layers act in equal and opposite pairs at a node and
+    drop out of a reaction); the last result is reused for the same ``u`` (all reaction probes
+    of a step)."""
+    if problem is not None:
+        f, _ = problem.assembler.evaluate(u, tangent=False)
+        return f - problem.external(load_factor)
+    cache = model.__dict__.setdefault("_reaction_cache", {})
+    if cache.get("dm") is not dm:
+        from ..assembly import Assembler
+        from ..loads import external_forces
+
+        cache.clear()
+        cache.update(dm=dm, asm=Assembler(model, dm), F=external_forces(model, dm))
+    if cache.get("lam") != load_factor or not np.array_equal(cache.get("u"), u):
+        f, _ = cache["asm"].evaluate(u, tangent=False)
+        cache.update(u=u.copy(), lam=load_factor, r=f - (load_factor * cache["F"][0] + cache["F"][1]))
+    return cache["r"]
+
+
+def _nodal_normals(model) -> np.ndarray:
+    """(n_nodes, 3) unit normal A3 of the reference surface at every node (from one element)."""
+    from ..element.geometry import surface_points
+
+    E = model.mesh.elements
+    sp = surface_points(model.mesh.nodes[E], np.broadcast_to(NODE_XI[:, 0], E.shape),
+                        np.broadcast_to(NODE_XI[:, 1], E.shape), per_element=True)
+    out = np.zeros((model.mesh.n_nodes, 3))
+    out[E.ravel()] = sp.A3.reshape(-1, 3)
+    return out
 
 
 def _node_points(model, nodes):
@@ -111,6 +235,12 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
             if pd.layer not in layer_index:
                 raise InputError(f"'{f}.layer': unknown layer '{pd.layer}'; defined: {list(layer_index)}")
             k = layer_index[pd.layer]
+        if pd.quantity in ("reaction", "resultant"):
+            out.append(_force_probe(pd, f, k, model, node_selection))
+            continue
+        if pd.direction is not None or pd.about is not None:
+            raise InputError(f"'{f}': 'direction' and 'about' belong to resultant probes; remove them from this "
+                             f"{pd.quantity} probe")
         if pd.quantity in ("debonded_area", "load_factor"):
             out.append(_global_probe(pd, f, k, model, node_selection))
             continue
@@ -151,8 +281,88 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         eta_all = np.repeat(eta, th.size)
         th_all = np.tile(th, P)
         out.append(Probe(pd.name, pd.quantity, comp, pd.measure, el_all, xi_all, eta_all, th_all, k, local,
-                         pd.reduce, pd.scale))
+                         pd.reduce, pd.scale, unit=pd.unit))
     return out
+
+
+REACTION_COMPONENTS = ("x", "y", "z", "mx", "my", "mz")
+RESULTANT_COMPONENTS = ("n", "m", "q", "nt", "mt")
+
+
+def _force_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
+    """A reaction (support nodes) or stress-resultant (a point) probe."""
+    from .errors import InputError
+
+    allowed = REACTION_COMPONENTS if pd.quantity == "reaction" else RESULTANT_COMPONENTS
+    if pd.component not in allowed:
+        raise InputError(f"'{f}.component': a {pd.quantity} probe needs component = one of {list(allowed)} "
+                         f"(got {pd.component!r})")
+    unused = {"layer": pd.layer, "theta3": pd.theta3 if pd.theta3 != 0.0 else None,
+              "reduce": pd.reduce if pd.reduce != "none" else None}
+    if pd.quantity == "reaction":
+        unused |= {"direction": pd.direction, "about": pd.about}
+    else:
+        unused |= {"where": pd.where, "set": pd.set}
+    extra = [key for key, v in unused.items() if v is not None]
+    if extra:
+        raise InputError(f"'{f}': a {pd.quantity} probe takes no {', '.join(map(repr, extra))}; remove "
+                         + ("them" if len(extra) > 1 else "it"))
+    empty = np.zeros(0)
+    if pd.quantity == "reaction":
+        nodes = node_selection(model.mesh, pd, f)
+        return Probe(pd.name, pd.quantity, pd.component, pd.measure, empty.astype(np.int64), empty, empty, empty,
+                     None, False, "none", pd.scale, nodes=nodes, unit=pd.unit)
+    if pd.point is None:
+        raise InputError(f"'{f}.point': a resultant probe needs a point on the reference surface")
+    if pd.direction is None:
+        raise InputError(f"'{f}.direction': a resultant probe needs the normal of the section, e.g. "
+                         "direction = [1, 0, 0] for the section x = const (m: the moment of σ_xx)")
+    dvec = np.asarray(pd.direction, float)
+    e, x, y, dist = locate(model, pd.point)
+    if dist > 1e-3 * model.mesh.size():
+        raise InputError(f"'{f}.point': {pd.point} is {dist:.4g} away from the reference surface; give a point on "
+                         "the reference surface")
+    els, xs, ys = _sharing(model, pd.point, e, dist)
+    from ..element.geometry import surface_points
+
+    sp = surface_points(model.mesh.nodes[model.mesh.elements[e]][None], np.array([[x]]), np.array([[y]]),
+                        per_element=True)
+    n3 = sp.A3[0, 0]
+    nd = np.linalg.norm(dvec)
+    if not nd > 0 or np.linalg.norm(dvec - (dvec @ n3) * n3) < 1e-6 * nd:
+        raise InputError(f"'{f}.direction': {pd.direction} is zero or along the shell normal at the point; give "
+                         "a direction in the tangent plane (the normal of the section)")
+    return Probe(pd.name, pd.quantity, pd.component, pd.measure, els, xs, ys, np.zeros(els.size), None, False,
+                 "none", pd.scale, direction=dvec / nd, about=pd.about, unit=pd.unit)
+
+
+def _sharing(model, point, e0: int, d0: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Every element whose reference surface contains ``point`` (as closely as the nearest,
+    element ``e0`` at distance ``d0``): the elements around the nearest node of ``e0``,
+    projected by Gauss-Newton iterations (as :func:`layershell.results.locate`)."""
+    from ..element.geometry import surface_points
+
+    mesh = model.mesh
+    point = np.asarray(point, float)
+    conn = mesh.elements[e0]
+    node = conn[np.argmin(np.linalg.norm(mesh.nodes[conn] - point, axis=1))]
+    cand = np.flatnonzero((mesh.elements == node).any(1))
+    X = mesh.nodes[mesh.elements[cand]]
+    x = np.zeros((cand.size, 2))
+    for _ in range(30):
+        sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+        A = sp.A[:, 0]
+        G = np.einsum("cia,cib->cab", A, A)
+        step = -np.linalg.solve(G, np.einsum("cia,ci->ca", A, sp.X0[:, 0] - point)[..., None])[..., 0]
+        x = np.clip(x + step, -1.0, 1.0)
+        if np.abs(step).max() < 1e-13:
+            break
+    sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+    dist = np.linalg.norm(sp.X0[:, 0] - point, axis=1)
+    keep = dist <= d0 + 1e-9 * mesh.size()
+    if not keep.any():
+        return np.array([e0]), np.zeros(1), np.zeros(1)
+    return cand[keep], x[keep, 0], x[keep, 1]
 
 
 def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
@@ -183,4 +393,4 @@ def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
                 return fm(tol=tol, **xyz)
     empty = np.zeros(0)
     return Probe(pd.name, pd.quantity, "", pd.measure, empty.astype(np.int64), empty, empty, empty, k, False,
-                 pd.reduce, pd.scale, where)
+                 pd.reduce, pd.scale, where, unit=pd.unit)

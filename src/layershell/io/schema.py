@@ -63,7 +63,17 @@ class ModelSettings(Strict):
 
 
 # ------------------------------------------------------------------ meshes
-class RectangleMesh(Strict):
+class MeshBase(Strict):
+    surface: Literal["reference", "middle"] = Field(
+        "reference", description="what the mesh describes: 'reference' the reference face (Θ³ = 0) itself, 'middle' "
+                                 "the mid-surface of the stack (e.g. a CAD/Gmsh shell), moved here by half the total "
+                                 "nodal thickness against the normal A3 (the averaged element normal at each node) "
+                                 "so that the stack lies half on each side (thickness formulas are evaluated on the mesh "
+                                 "as given); selections and points of supports, loads and probes then refer to the "
+                                 "moved (reference) face")
+
+
+class RectangleMesh(MeshBase):
     type: Literal["rectangle"]
     lx: PositiveFloat
     ly: PositiveFloat
@@ -71,9 +81,13 @@ class RectangleMesh(Strict):
     ny: PositiveInt
     origin: Vec3 = [0.0, 0.0, 0.0]
     normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
+    grading_x: PositiveFloat = Field(
+        1.0, ge=1e-4, le=1e4, description="size of the last element along x over the first (geometric grading; > 1 refines "
+                                 "towards the origin edge, < 1 towards x = origin + lx; 1: uniform)")
+    grading_y: PositiveFloat = Field(1.0, ge=1e-4, le=1e4, description="the same along y")
 
 
-class CylinderMesh(Strict):
+class CylinderMesh(MeshBase):
     type: Literal["cylinder"]
     radius: PositiveFloat = Field(description="radius of the reference face")
     angle_start: float = 0.0
@@ -102,7 +116,7 @@ class MeridianSegment(Strict):
                           "default: straight")
 
 
-class RevolutionMesh(Strict):
+class RevolutionMesh(MeshBase):
     type: Literal["revolution"]
     meridian_r: list[float] = Field(min_length=2)
     meridian_z: list[float] = Field(min_length=2)
@@ -140,7 +154,7 @@ class RevolutionMesh(Strict):
         return self
 
 
-class FileMesh(Strict):
+class FileMesh(MeshBase):
     type: Literal["file"]
     path: str = Field(description="mesh file read with meshio (Gmsh .msh, .vtu, ...), relative to the model file")
     scale: PositiveFloat = 1.0
@@ -214,9 +228,21 @@ class FixDef(Strict):
     where: str | None = None
     set: str | None = None
     point: Vec3 | None = None
-    layer: str | None = Field(None, description="default: the layer at the reference face")
-    directors: Union[Literal["all"], list[int]] = [0]
-    components: list[Component] = ["x", "y", "z"]
+    layer: str | None = Field(
+        None, description="layer name, or 'all': every layer at the nodes (a support through the whole thickness); "
+                          "default: the layer at the reference face")
+    directors: Union[Literal["all"], list[int]] = Field(
+        [0], description="director vectors u_l held (u_0: the layer's bottom face); not with 'face'/'height'")
+    components: list[Component] = Field(["x", "y", "z"], description="global displacement components held")
+    face: Literal["bottom", "top"] | None = Field(
+        None, description="the support acts on this face of 'layer' (Σ_l (Θ_L³)^l u_l · e = 0; a bonded face "
+                          "is shared with the neighbour layer), e.g. layer = 'concrete', face = 'bottom' for a "
+                          "bearing under the concrete while another layer lies below it")
+    height: float | None = Field(
+        None, description="Θ³ (from the reference face, length) at which the support acts, inside 'layer' (default: "
+                          "the layer containing it; at an interface the upper one)")
+    direction: Vec3 | None = Field(
+        None, description="held direction (global vector, e.g. [0, 0, 1] for a bearing); instead of 'components'")
 
 
 class SymmetryDef(Strict):
@@ -233,8 +259,8 @@ class HingeDef(Strict):
     set: str | None = None
     point: Vec3 | None = None
     direction: Union[Vec3, Literal["edge-normal"]] = Field(
-        description="hinge direction: a global vector (not the thickness direction) or 'edge-normal', the in-plane "
-                    "normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
+        description="hinge direction: a global vector (any, the thickness direction included) or 'edge-normal', the "
+                    "in-plane normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
     height: float | None = Field(None, description="Θ³ of the hinge; default mid-thickness")
     fixed: bool = Field(True, description="fixed hinge (u0 of the first layer along 'direction' only) or sliding")
 
@@ -263,6 +289,9 @@ class EdgeLoadDef(Strict):
                     "with 'face': a line force per edge length on that face")
     face: Literal["top", "reference"] | None = Field(
         None, description="apply a line force on the edge of the top (opposite) or reference face, (2.175)/(2.180)")
+    height: float | None = Field(
+        None, description="a line force per edge length at this Θ³ (from the reference face, length), split into "
+                          "director forces (Θ_L³)^l q of the layer containing it (the upper one at an interface)")
     scaled: bool = True
 
 
@@ -290,7 +319,14 @@ class NodalLoadDef(Strict):
     point: Vec3 | None = None
     layer: str | None = None
     director: int = Field(0, ge=0, le=4)
-    value: Vec3
+    value: Vec3 = Field(description="force (director 0) or director force (force × length^director), global")
+    height: float | None = Field(
+        None, description="Θ³ (from the reference face, length) at which the force acts, e.g. the mid-surface; it is "
+                          "split into the director forces (Θ_L³)^l F of the layer containing it (the upper one at "
+                          "an interface, or 'layer'); not with 'director'")
+    face: str | None = Field(
+        None, description="'reference', 'top' or 'layer:<name>' (the bottom face of that layer): the force acts on "
+                          "that face (split into director forces like 'height')")
     scaled: bool = True
 
 
@@ -314,9 +350,14 @@ class Steps(Strict):
 
 class ProbeDef(Strict):
     name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
-    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor"] = Field(
+    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor", "reaction",
+                      "resultant"] = Field(
         description="debonded_area: released area of the interface below `layer` (within `where`, a formula "
-                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units)")
+                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units); "
+                    "reaction: force (component x|y|z) or moment about the origin (mx|my|mz) that the supports "
+                    "exert at the selected nodes (where/set/point), R = f_int − F_ext summed over the nodes' "
+                    "rigid-body modes; resultant: stress resultant per unit width at `point`, integrated through "
+                    "all layers (component n|m|q|nt|mt on the section whose normal is `direction`)")
     point: Vec3 | None = Field(None, description="displacement: nearest node; stress: point on the reference surface")
     where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area: "
                                                 "interface points counted")
@@ -330,6 +371,16 @@ class ProbeDef(Strict):
     layer: str | None = None
     reduce: Literal["max", "min", "absmax", "mean", "none"] = "none"
     scale: FiniteFloat = 1.0
+    direction: Vec3 | None = Field(
+        None, description="resultant: normal of the section (a global vector, projected on the tangent plane); n, m: "
+                          "normal force and moment of the stresses along it, q: transverse shear, nt/mt: in-plane "
+                          "shear and twisting moment; per unit width")
+    about: FiniteFloat | None = Field(
+        None, description="resultant: Θ³ (from the reference face) of the axis of m and mt; default: mid-height of "
+                          "the stack at the point. m > 0 puts the side of larger Θ³ in tension")
+    unit: str | None = Field(
+        None, description="unit of the probe's value (after 'scale') written on plot axes, e.g. 'mm' or 'kN'; "
+                          "default: the unit system of [model] units")
 
     @field_validator("theta3")
     @classmethod
@@ -343,6 +394,15 @@ class ProbeDef(Strict):
         elif not math.isfinite(v):
             raise ValueError(f"must be a finite number (got {v}); give Θ³ from the reference face")
         return v
+
+
+class PlotDef(Strict):
+    """A figure plot_<name>.png of one probe against another over the converged steps."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description="file name: plot_<name>.png")
+    x: str = Field(description="probe on the horizontal axis (e.g. the midspan deflection in mm)")
+    y: str = Field(description="probe on the vertical axis (e.g. a load_factor probe scaled to the load in kN/m²)")
+    title: str = Field("", description="figure title (default: 'y against x')")
 
 
 class ProfileDef(Strict):
@@ -431,6 +491,7 @@ class ModelFile(Strict):
     steps: Steps = Steps()
     probes: list[ProbeDef] = []
     profiles: list[ProfileDef] = []
+    plots: list[PlotDef] = []
     interfaces: list[InterfaceDef] = []
     delamination: DelaminationDef = DelaminationDef()
     output: OutputDef = OutputDef()
@@ -456,4 +517,9 @@ class ModelFile(Strict):
         if dup:
             raise ValueError(f"'probes': probe names must be unique, but {sorted(dup)} appear more than once; "
                              "rename the probes")
+        for i, pl in enumerate(self.plots):
+            for axis in ("x", "y"):
+                if getattr(pl, axis) not in pn:
+                    raise ValueError(f"'plots[{i}].{axis}': unknown probe '{getattr(pl, axis)}'; defined: {pn} (add a "
+                                     "[[probes]] table, e.g. quantity = 'load_factor' with scale = the load)")
         return self
