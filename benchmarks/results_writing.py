@@ -12,7 +12,17 @@ time per step grew linearly with the step number (quadratic total); with the rec
 per-step files are appended and the checkpoint holds the state only, so it stays flat.
 
 Run it once with the sources of each version on PYTHONPATH to compare. Last line:
-``results_writing {json}``.
+``results_writing {json}``. Measured (1500 steps, a shared 2-core machine, so ±30 % noise):
+
+=====================  ========  ==============  ==================  =================
+version                total s   not solving s   ms/step first 100   ms/step last 100
+=====================  ========  ==============  ==================  =================
+before (db602f8)       83.7      71.3            35.7                78.1
+recorder (issue 15)    19.3      10.7            18.0                12.2
+=====================  ========  ==============  ==================  =================
+
+(an earlier, more loaded pair: 122.5 s with 44 → 152 ms/step before, 40.0 s with 35 → 33 ms/step
+after, the checkpoint then still fsynced at every step).
 """
 from __future__ import annotations
 
