@@ -192,6 +192,25 @@ def test_a_rerun_of_the_same_model_file_replaces_its_results(tmp_path):
     assert MANIFEST in names
 
 
+def test_a_model_that_fails_to_build_leaves_the_earlier_results(tmp_path, monkeypatch):
+    """The earlier run's files are removed only once the new run is set up: a rerun whose model
+    cannot be built (here: the problem set-up raises) leaves them as they were."""
+    from layershell.solver.problem import Problem
+
+    model = _model(tmp_path, steps=2)
+    out = tmp_path / "out"
+    assert run(load(model), out, write_vtu=False).converged
+    before = {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()}
+
+    def broken(cls, m):
+        raise ValueError("supports cannot be set up")
+
+    monkeypatch.setattr(Problem, "build", classmethod(broken))
+    with pytest.raises(ValueError, match="supports"):
+        run(load(model), out, write_vtu=False)
+    assert {p.name: p.read_bytes() for p in out.iterdir() if p.is_file()} == before
+
+
 # ------------------------------------------------------------------ atomic files
 
 

@@ -151,6 +151,7 @@ class Recorder:
         self.overwrite, self.resume, self.echo = overwrite, resume, echo
         self.summary_budget = summary_budget
         self._lock_fd: int | None = None
+        self._doomed: list[Path] = []
         self._known: set[str] = set()
         self._manifest = None
         self._log = None
@@ -172,30 +173,25 @@ class Recorder:
         self.close()
 
     def open(self) -> None:
-        """Create and lock the folder; remove an earlier run's files (or refuse, see the class)."""
+        """Create and lock the folder and check an earlier run's files (refused: another model
+        without ``overwrite``). They are removed only by :meth:`begin`, when the new run has been
+        set up (so that a model that fails to build leaves the earlier results alone)."""
         self.folder.mkdir(parents=True, exist_ok=True)
         self._lock_fd = _lock(self.folder)
         try:
-            if not self.resume:
-                self._clear_earlier()
-            man = self.folder / MANIFEST
-            if man.is_file():
-                self._known = {ln.strip() for ln in man.read_text(encoding="utf-8", errors="replace").splitlines()}
-            self._manifest = open(man, "a", encoding="utf-8")
-            os.chmod(man, FILE_MODE)
-            self._log = open(self.folder / RUN_LOG, "a" if self.resume else "w", encoding="utf-8")
-            self._register(RUN_LOG)
+            self._doomed = [] if self.resume else self._earlier()
         except BaseException:
             self.close()
             raise
 
-    def _clear_earlier(self) -> None:
+    def _earlier(self) -> list[Path]:
+        """The earlier run's files to remove; ResultsFolderError if they are another model's."""
         prev = _earlier_model(self.folder)
         if prev is None:
-            return
+            return []
         files = earlier_files(self.folder)
         if not files:
-            return
+            return []
         same = (_same_file(prev.get("model_file"), self.model_file)
                 or (self.model_hash and prev.get("model_hash") == self.model_hash))
         if not same and not self.overwrite:
@@ -205,11 +201,25 @@ class Recorder:
                 f"the results folder '{self.folder}' holds the results {what} ({len(files)} file(s)); a run of "
                 f"'{self.model_file}' there would mix two models' files: give this run another folder with "
                 "--out, or add --overwrite to delete those results first")
-        for p in files:
+        return files
+
+    def _start(self) -> None:
+        """Remove the earlier run's files, open the manifest and run.log."""
+        if self._manifest is not None:
+            return
+        for p in self._doomed:
             try:
                 p.unlink()
             except FileNotFoundError:
                 pass
+        self._doomed = []
+        man = self.folder / MANIFEST
+        if man.is_file():
+            self._known = {ln.strip() for ln in man.read_text(encoding="utf-8", errors="replace").splitlines()}
+        self._manifest = open(man, "a", encoding="utf-8")
+        os.chmod(man, FILE_MODE)
+        self._log = open(self.folder / RUN_LOG, "a" if self.resume else "w", encoding="utf-8")
+        self._register(RUN_LOG)
 
     def close(self) -> None:
         for f in (self._probes, self._delam):
@@ -268,7 +278,9 @@ class Recorder:
     # ----------------------------------------------------------------- per-step results
 
     def begin(self, probe_names: list[str], history: list[dict]) -> None:
-        """Start the per-step files with ``history`` (the steps before a restart, else empty)."""
+        """Take over the folder (the earlier run's files go now) and start the per-step files
+        with ``history`` (the steps before a restart, else empty)."""
+        self._start()
         self.probe_names = list(probe_names)
         lines = "".join(json.dumps(r) + "\n" for r in history)
         atomic_write(self.path(STEPS), lambda tmp: tmp.write_text(lines, encoding="utf-8"))
