@@ -485,6 +485,13 @@ def test_report_of_a_damaged_summary_and_a_missing_model_file(tmp_path):
     assert r.returncode == 2 and "--model" in r.stderr and "no such file" in r.stderr, r.stderr
     r = _cli(["report", out, "--model", model], tmp_path)
     assert r.returncode == 0, r.stderr
+    s = json.loads((out / "summary.json").read_text())  # as after a kill between two summary rewrites
+    with (out / "steps.jsonl").open("a") as f:
+        f.write(json.dumps(dict(s["steps"][0], step=2, load_factor=2.0)) + "\n")
+    r = _cli(["report", out], tmp_path)
+    assert r.returncode == 0, r.stderr
+    html = (out / "report.html").read_text(encoding="utf-8")
+    assert "steps.jsonl records 2 converged step(s)" in html
     text = (out / "summary.json").read_text()
     (out / "summary.json").write_text(text[: len(text) // 2])
     r = _cli(["report", out], tmp_path)

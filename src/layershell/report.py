@@ -87,6 +87,22 @@ def _read_json(path: Path) -> dict | None:
     return data if isinstance(data, dict) else None
 
 
+def _read_steps(path: Path) -> list[dict]:
+    """The step records of steps.jsonl (written by the recorder, one line per converged step)."""
+    out: list[dict] = []
+    try:
+        with path.open(encoding="utf-8") as f:
+            for ln in f:
+                rec = json.loads(ln)
+                if not isinstance(rec, dict):
+                    break
+                rec.pop("files", None)
+                out.append(rec)
+    except (OSError, ValueError, UnicodeDecodeError):
+        pass  # missing, or a line cut short by a kill: what was read
+    return out
+
+
 def _json_problem(path: Path) -> str:
     """Why ``path`` is not a JSON object (for the error message)."""
     try:
@@ -159,6 +175,12 @@ def render(folder: str | Path, model: str | Path | None = None) -> str:
         raise InputError(f"'{folder / 'summary.json'}' cannot be read ({_json_problem(folder / 'summary.json')}), so "
                          "the report would lack the run's results; the file is damaged (cut short or edited): rerun "
                          "the model into this folder (layershell run MODEL --out DIR) or restore the file")
+    recorded = _read_steps(folder / "steps.jsonl")
+    if summary and len(recorded) > len(summary.get("steps") or []):  # summary.json lags (run killed)
+        notes.append(f"summary.json lists {len(summary.get('steps') or [])} step(s) but steps.jsonl records "
+                     f"{len(recorded)} converged step(s) (summary.json is rewritten at a bounded rate and the run "
+                     "was stopped before its last rewrite); the step tables show steps.jsonl.")
+        summary = dict(summary, steps=recorded)
     title = summary.get("title") or folder.name
     now = dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M:%S UTC")
     run_time = _utc((folder / "summary.json").stat().st_mtime) if (folder / "summary.json").is_file() else ""
