@@ -51,6 +51,8 @@ def _load(model: Path):
         spec = load(model)
         for note in spec.model.mesh.notes:  # e.g. quad4/quad8 converted to quad9
             err.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+        for text in spec.warnings:  # valid but almost surely not meant (e.g. no loads)
+            err.print(f"warning: {escape(f'{spec.path}: {text}')}", highlight=False, soft_wrap=True)
         return spec
     except InputError as exc:
         _fail(str(exc))
