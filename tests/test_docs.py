@@ -16,6 +16,59 @@ def test_model_file_reference_is_up_to_date():
         "run: python docs/gen_model_file_doc.py"
 
 
+def _tables() -> list:
+    """Every table (pydantic model) a model file can contain, reached from ModelFile's keys."""
+    import typing
+
+    from pydantic import BaseModel
+
+    from layershell.io import schema
+
+    def walk(tp, seen):
+        if isinstance(tp, type) and issubclass(tp, BaseModel):
+            if tp not in seen:
+                seen.append(tp)
+                for f in tp.model_fields.values():
+                    walk(f.annotation, seen)
+        for a in typing.get_args(tp):
+            walk(a, seen)
+        return seen
+
+    return walk(schema.ModelFile, [])[1:]
+
+
+def test_every_key_has_a_meaning():
+    """Issue 15: the reference gives a one-line meaning for every key of every table."""
+    missing = [f"{cls.__name__}.{name}" for cls in _tables() for name, f in cls.model_fields.items()
+               if name != "type" and not (f.description or "").strip()]
+    assert not missing, f"add description= to these fields in io/schema.py: {missing}"
+
+
+def test_every_table_is_in_the_reference():
+    sys.path.insert(0, str(ROOT / "docs"))
+    import gen_model_file_doc
+
+    documented = {cls for _, cls, _ in gen_model_file_doc.SECTIONS}
+    missing = [cls.__name__ for cls in _tables() if cls not in documented]
+    assert not missing, f"add these tables to SECTIONS in docs/gen_model_file_doc.py: {missing}"
+
+
+def test_reference_types_are_readable():
+    """No pydantic/typing reprs such as Optional[list[float], FieldInfo(annotation=none, ...MinLen...)]."""
+    text = (ROOT / "docs" / "model-file.md").read_text(encoding="utf-8")
+    for raw in ("FieldInfo", "typing", "Annotated", "Optional[", "Union[", "<class", "layershell.io", "MinLen",
+                "Gt(", "NoneType"):
+        assert raw not in text, raw
+    for raw in (r"\bfloat\b", r"\bint\b", r"\bstr\b", r"\bNone\b", r"\bTrue\b"):
+        assert not re.search(raw, text), raw
+    rows = [r for r in text.splitlines() if r.startswith("| `")]
+    assert len(rows) >= 150
+    kinds = {r.split(" | ")[1] for r in rows}
+    for expected in ("list of 3 numbers", "number > 0", 'list of "x", "y", "z"', 'one of "+z", "-z"',
+                     "number or formula in x, y, z", "integer from 0 to 4", "condition in x, y, z", "true/false"):
+        assert expected in kinds, (expected, sorted(kinds))
+
+
 def test_readme_python_quick_start_runs(tmp_path, monkeypatch):
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     code = re.findall(r"```python\n(.*?)```", text, re.S)[0]
