@@ -87,6 +87,30 @@ def test_readme_shows_the_two_commands():
     assert os.access(ROOT / ".ci" / "run", os.X_OK)
 
 
+def test_quick_start_puts_layershell_on_path():
+    """The quick start types `layershell` bare: it first activates the environment that `make demo`
+    installs into, and `make demo` itself ends by saying how (issue 15)."""
+    import shutil
+    import subprocess
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"## Quick start\n\n```bash\n(.*?)```", text, re.S).group(1).splitlines()
+    bare = [i for i, line in enumerate(block) if line.startswith("layershell ")]
+    activate = [i for i, line in enumerate(block) if line.startswith("source .venv/bin/activate")]
+    assert bare and activate and activate[0] < bare[0], block
+    if shutil.which("make"):
+        dry = subprocess.run(["make", "-n", "demo"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+        assert "source .venv/bin/activate" in dry.stdout, dry.stdout + dry.stderr
+    if sys.prefix != sys.base_prefix and os.name == "posix" and shutil.which("bash"):
+        # in a virtual environment (make test uses .venv): its activate script puts layershell on PATH
+        env = {k: v for k, v in os.environ.items() if k != "VIRTUAL_ENV"}
+        env["PATH"] = "/usr/bin:/bin"
+        found = subprocess.run(["bash", "-c", f'source "{sys.prefix}/bin/activate" && command -v layershell'],
+                               capture_output=True, text=True, env=env, timeout=60)
+        assert found.returncode == 0, found.stderr
+        assert Path(found.stdout.strip()).resolve() == (Path(sys.prefix) / "bin" / "layershell").resolve()
+
+
 def test_user_guide_refers_to_existing_files():
     """docs/user-guide.md is linked from the README, and every example, doc and output figure it
     names exists / is written by the code (figure names checked against plots.write_figures)."""
