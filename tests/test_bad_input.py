@@ -194,3 +194,16 @@ def test_sweep_with_a_million_variants_is_refused_at_once(tmp_path):
     assert time.perf_counter() - t0 < 20
     _assert_error(o, ("1,000,000 variants", "1000 (materials.mat.E) × 1000 (steps.n)", "10,000"))
     assert not (tmp_path / "out").exists()
+
+
+def test_sweep_reports_progress_while_checking_the_variants(tmp_path):
+    """A long validation is not silent: ``checking(i, n)`` follows it (the CLI shows a progress bar)."""
+    from layershell.io.build import InputError
+    from layershell.sweep import sweep
+
+    calls = []
+    with pytest.raises(InputError, match="variant 2"):
+        sweep(EXAMPLES / "cantilever_thick.toml", [("materials.mat.E", [1000.0, 2000.0, -1.0])], tmp_path / "out",
+              checking=lambda i, n: calls.append((i, n)))
+    assert calls == [(1, 3), (2, 3)]
+    assert not (tmp_path / "out").exists()

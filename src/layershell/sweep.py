@@ -258,12 +258,14 @@ def run_variant(index: int, values: dict[str, Any], data: dict, base: str, out: 
 
 
 def sweep(model: str | Path, sets: list[tuple[str, list[Any]]], out: str | Path, jobs: int | None = None,
-          vtu: bool = False, progress: Callable[[dict], None] | None = None) -> SweepResult:
+          vtu: bool = False, progress: Callable[[dict], None] | None = None,
+          checking: Callable[[int, int], None] | None = None) -> SweepResult:
     """Run every combination of ``sets`` (``[(dotted key, [values])]``) and write ``out/sweep.csv``.
 
     All variants are validated and built before any is solved, so bad input fails fast
     (InputError naming the key and the variant). Variants run in ``jobs`` processes (default:
-    the number of CPU cores); each writes its results into ``out/vNNN/``."""
+    the number of CPU cores); each writes its results into ``out/vNNN/``. ``checking(i, n)`` is
+    called after each of the n variants is validated (progress of a long validation)."""
     from .io.output import write_csv, write_json
 
     model = Path(model)
@@ -276,6 +278,8 @@ def sweep(model: str | Path, sets: list[tuple[str, list[Any]]], out: str | Path,
         d = with_values(data, vals)
         build_spec(d, model.parent, f"{model}: variant {i} (--set {describe(vals)})")
         docs.append(d)
+        if checking:
+            checking(i + 1, len(combos))
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     keys = [k for k, _ in sets]
