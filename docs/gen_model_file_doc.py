@@ -176,8 +176,8 @@ def render() -> str:
            "",
            "Units: layershell has no unit system of its own; give every value in one consistent set (e.g. kN and m, "
            "so stresses in kN/m²). The meanings name the kind of quantity: (length), (force/area), (force), "
-           "(degrees). Types: *number* is a decimal or whole number, *integer* a whole number, *condition* a formula that is "
-           "true or false at each point; *not set* means the key may be left out.", ""]
+           "(degrees). Types: *number* is a decimal or whole number, *integer* a whole number, *condition* a "
+           "formula that is true or false at each point; *not set* means the key may be left out.", ""]
     for title, cls, text in SECTIONS:
         out += [f"## `{title}`", "", text, "", "| key | type | default | meaning |", "|---|---|---|---|"]
         for name, fld in cls.model_fields.items():

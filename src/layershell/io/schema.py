@@ -232,7 +232,8 @@ class FixDef(Strict):
     where: str | None = Field(None, description=_NODES)
     set: str | None = Field(None, description=_SET_N)
     point: Vec3 | None = Field(None, description=_POINT)
-    layer: str | None = Field(None, description="default: the layer at the reference face")
+    layer: str | None = Field(None, description=(
+        "layer whose directors are held; default: the layer at the reference face"))
     directors: Union[Literal["all"], list[int]] = Field([0], description=(
         "director numbers l held (0: the displacement of the layer's bottom face), or 'all'"))
     components: list[Component] = Field(["x", "y", "z"], description="global components held at zero")
