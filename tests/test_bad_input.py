@@ -109,6 +109,12 @@ def test_no_loads_run_warns_and_runs(tmp_path):
     assert "warning:" in o.stderr and "no [[loads]]" in o.stderr, _describe(o)
 
 
+def test_zero_loads_are_warned(tmp_path):
+    o = _outcome(tmp_path, "zeroload", Case("cantilever_thick.toml", _set("loads.0.distribution", 0.0)))
+    assert o.returncode == 0 and "OK" in o.stdout, _describe(o)
+    assert o.stderr.strip().startswith("warning:") and "every [[loads]] entry is zero" in o.stderr, _describe(o)
+
+
 def test_gravity_without_density_is_an_error(tmp_path):
     o = _outcome(tmp_path, "gravity0", Case("cantilever_thick.toml", _set("loads", [{"type": "gravity"}])))
     _assert_error(o, ("loads[0]", "density", "[materials.mat]"))

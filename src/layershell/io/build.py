@@ -528,6 +528,15 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
                                              d.max_debond_fraction, d.max_debond_cuts, d.reequilibrate)
 
 
+def _zero_load(ld) -> bool:
+    """A load whose value is the number 0 (formulas and other load types: not known to be zero)."""
+    value = {"surface": "magnitude", "edge": "distribution", "volume": "value", "nodal": "value"}.get(ld.type)
+    v = getattr(ld, value, None) if value else None
+    if isinstance(v, (int, float)):
+        return v == 0
+    return isinstance(v, list) and all(isinstance(c, (int, float)) and c == 0 for c in v)
+
+
 def _check_gravity(model: Model, el: np.ndarray, g: np.ndarray, field: str) -> None:
     """A gravity load acts on the density of the layers: with g = 0 or no mass it is silently zero."""
     if not np.abs(g).max() > 0:
@@ -748,6 +757,9 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     if not mf.loads:
         notes.append("the model has no [[loads]], so every displacement, stress and probe value is zero; add a "
                      "[[loads]] table (type = 'surface', 'edge', 'volume', 'gravity' or 'nodal'), see examples/")
+    elif all(_zero_load(ld) for ld in mf.loads):
+        notes.append("every [[loads]] entry is zero (magnitude, distribution or value 0), so every displacement, "
+                     "stress and probe value is zero; give the loads their values")
     st = mf.steps
     if st.factors is not None:
         lf = np.asarray(st.factors, float)
