@@ -317,8 +317,7 @@ def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
     c = m.nodes[m.elements[:, 8]]
     el = np.flatnonzero(_condition(m, where, f"{field}.where", c))
     if el.size == 0:
-        lo, hi = c.min(0), c.max(0)
-        span = ", ".join(f"{n} ∈ [{a:.6g}, {b:.6g}]" for n, a, b in zip(XYZ, lo, hi))
+        span = _span(c)
         raise InputError(f"'{field}.where': '{where}' selects no element (it is tested at the element centres, "
                          f"which span {span}); widen the condition or use near(x, value)")
     return el
@@ -556,7 +555,7 @@ def _check_gravity(model: Model, el: np.ndarray, g: np.ndarray, field: str) -> N
 MAX_THICKNESS_RATIO = 1.0
 
 
-def _check_slender(model: Model, mf: schema.ModelFile) -> None:
+def _check_slender(model: Model) -> None:
     """A shell is thin compared with its extent: a laminate thicker than the whole model is a unit
     mistake (mm vs m), and its stiffness is singular or meaningless, which the solver would
     otherwise report as free rigid-body motions of the supports."""
@@ -651,14 +650,15 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         if np.any(element_stack < 0):
             bad = np.flatnonzero(element_stack < 0)
             raise InputError(f"'stacks': {bad.size} element(s) belong to no stack (first: element {bad[0]}); "
-                             "add a stack without 'where' and 'set' (it takes the remaining elements) or widen the selections")
+                             "add a stack without 'where' and 'set' (it takes the remaining elements) or widen "
+                             "the selections")
     model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
                   nonlinear=mf.model.nonlinear, units=mf.model.units)
     try:
         model.below()
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
-    _check_slender(model, mf)
+    _check_slender(model)
     first = stacks[0][0]
 
     # supports
