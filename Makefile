@@ -14,6 +14,10 @@ $(STAMP): pyproject.toml
 
 demo: $(STAMP)
 	$(BIN)/layershell run examples/cantilever_thick.toml --out results/cantilever_thick
+	@echo ""
+	@echo "layershell is installed in $(VENV)/. To type 'layershell' in this shell, activate it first:"
+	@echo "    source $(VENV)/bin/activate"
+	@echo "(or call $(BIN)/layershell directly; 'deactivate' leaves the environment)"
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -m "not slow"

@@ -6,9 +6,11 @@ tests/test_docs.py checks that the file is up to date.
 """
 from __future__ import annotations
 
+import types
 import typing
 from pathlib import Path
 
+import annotated_types
 from pydantic import BaseModel
 
 from layershell.io import schema
@@ -31,14 +33,18 @@ SECTIONS = [
     ("[materials.NAME] type = \"orthotropic\"", schema.OrthotropicMat,
      "Orthotropic material, nine constants in the material frame (axis 3 = shell normal)."),
     ("[[layers]]", schema.LayerDef, "Layers, from the reference face outward."),
-    ("[[stacks]]", schema.StackDef, "Optional: which elements carry which layers (default: all layers everywhere)."),
+    ("[[stacks]]", schema.StackDef,
+     "Optional: which elements carry which layers (default: all layers everywhere). Every element carries exactly "
+     "one stack: selections must not overlap, and one stack without `where` and `set` takes the remaining "
+     "elements."),
     ("[[supports]] type = \"fix\"", schema.FixDef, "Zero displacement components of chosen directors."),
     ("[[supports]] type = \"symmetry\"", schema.SymmetryDef, "Symmetry plane: u_l · n = 0 for all directors and layers."),
     ("[[supports]] type = \"hinge\"", schema.HingeDef, "Hinged support at a height in the thickness (thesis 3.4.2)."),
     ("[[loads]] type = \"surface\"", schema.SurfaceLoadDef, "Traction per reference area on a face."),
     ("[[loads]] type = \"edge\"", schema.EdgeLoadDef, "Traction through the thickness on boundary edges."),
     ("[[loads]] type = \"volume\"", schema.VolumeLoadDef, "Body force per volume."),
-    ("[[loads]] type = \"gravity\"", schema.GravityDef, "Self-weight from the materials' density."),
+    ("[[loads]] type = \"gravity\"", schema.GravityDef,
+     "Self-weight from the materials' density (the loaded layers need a material with density > 0)."),
     ("[[loads]] type = \"nodal\"", schema.NodalLoadDef, "Director forces given directly at nodes."),
     ("[steps]", schema.Steps, "Load stepping and Newton settings."),
     ("[[probes]]", schema.ProbeDef, "Named scalar outputs, one value per converged step."),
@@ -52,12 +58,116 @@ SECTIONS = [
 ]
 
 
-def _type(ann) -> str:
-    s = str(ann)
-    for a, b in (("typing.", ""), ("<class '", ""), ("'>", ""), ("NoneType", "none"),
-                 ("Annotated[", ""), ("Literal", "one of ")):
-        s = s.replace(a, b)
-    return s.replace("|", " or ")
+def _bounds(meta) -> str:
+    """' > 0', ' 0 to 1', ... from annotated_types constraints (Gt, Ge, Lt, Le)."""
+    lo = hi = None
+    for m in meta:
+        for attr, op in (("gt", ">"), ("ge", "≥")):
+            if getattr(m, attr, None) is not None:
+                lo = (op, getattr(m, attr))
+        for attr, op in (("lt", "<"), ("le", "≤")):
+            if getattr(m, attr, None) is not None:
+                hi = (op, getattr(m, attr))
+    num = lambda v: f"{v:g}" if isinstance(v, float) else f"{v:,}".replace(",", " ")  # noqa: E731
+    if lo and hi:
+        if lo[0] == "≥" and hi[0] == "≤":
+            return f" from {num(lo[1])} to {num(hi[1])}"
+        return f" {lo[0]} {num(lo[1])} and {hi[0]} {num(hi[1])}"
+    if lo:
+        return f" {lo[0]} {num(lo[1])}"
+    return f" {hi[0]} {num(hi[1])}" if hi else ""
+
+
+def _lengths(meta) -> tuple[int | None, int | None]:
+    lo = next((m.min_length for m in meta if getattr(m, "min_length", None) is not None), None)
+    hi = next((m.max_length for m in meta if getattr(m, "max_length", None) is not None), None)
+    return lo, hi
+
+
+def _plural(word: str) -> str:
+    return {"text": "texts", "true/false": "true/false values"}.get(word.split(" ")[0], word.split(" ")[0] + "s") \
+        + word[len(word.split(" ")[0]):]
+
+
+def _type(ann, meta=()) -> str:
+    """A type annotation in words: 'number > 0', 'list of 3 numbers', "one of 'x', 'y'", ..."""
+    meta = list(meta)
+    origin, args = typing.get_origin(ann), typing.get_args(ann)
+    if origin is typing.Annotated:
+        return _type(args[0], meta + [m for a in args[1:] for m in (getattr(a, "metadata", None) or [a])])
+    if ann is schema.NumOrFormula or (origin in (typing.Union, types.UnionType) and set(args) == {float, str}):
+        return "number or formula"
+    if origin in (typing.Union, types.UnionType):
+        arms = [a for a in args if a is not type(None)]
+        parts = [_type(a, meta if len(arms) == 1 else ()) for a in arms]  # Field(ge=...) of an optional number
+        return " or ".join(dict.fromkeys(parts))
+    if origin is typing.Literal:
+        vals = ", ".join(f'"{a}"' for a in args)
+        return vals if len(args) == 1 else f"one of {vals}"
+    if origin is list:
+        item = _type(args[0]) if args else "value"
+        lo, hi = _lengths(meta)
+        if isinstance(args[0], type) and issubclass(args[0], BaseModel):
+            return "list of tables {...}"
+        if item.startswith("one of "):
+            return f"list of {item.removeprefix('one of ')}"
+        if lo is not None and lo == hi:
+            return f"list of {lo} {_plural(item)}"
+        if lo is not None and hi is not None:
+            return f"list of {lo} {'or' if hi == lo + 1 else 'to'} {hi} {_plural(item)}"
+        if lo is not None and lo > 1:
+            return f"list of at least {lo} {_plural(item)}"
+        return f"list of {_plural(item)}"
+    if isinstance(ann, type) and issubclass(ann, BaseModel):
+        return "table {...}"
+    if ann is bool:
+        return "true/false"
+    if ann is int:  # whole numbers: > 0 is ≥ 1
+        meta = [annotated_types.Ge(m.gt + 1) if getattr(m, "gt", None) is not None else m for m in meta]
+        return "integer" + _bounds(meta)
+    if ann is float:
+        return "number" + _bounds(meta)
+    if ann is str:
+        pattern = next((m.pattern for m in meta if getattr(m, "pattern", None)), None)
+        if pattern:
+            return "name (letters, digits, _)"
+        return "text" + (" (not empty)" if _lengths(meta)[0] else "")
+    return str(ann)
+
+
+#: formulas whose variables are not x, y, z
+FORMULA_VARIABLES = {(schema.EdgeLoadDef, "distribution"): "t, x, y, z"}
+
+
+def _key_type(cls, name: str, fld) -> str:
+    """The type column of key ``name`` of table ``cls``."""
+    kind = _type(fld.annotation, fld.metadata)
+    if kind == "number or formula":
+        kind += " in " + FORMULA_VARIABLES.get((cls, name), "x, y, z")
+    if name == "where" and kind == "text":
+        kind = "condition in x, y, z"
+    return kind
+
+
+def _default(fld) -> str:
+    if fld.is_required():
+        return "required"
+    v = fld.get_default(call_default_factory=True)
+    if v is None:
+        return "not set"
+    return f"`{_toml(v)}`"
+
+
+def _toml(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return f'"{v}"'
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml(x) for x in v) + "]"
+    if isinstance(v, float):
+        return repr(v).replace("e-0", "e-")
+    return str(v)
 
 
 def render() -> str:
@@ -67,15 +177,21 @@ def render() -> str:
            "selections with `where`) use a safe parser: arithmetic, comparisons, `and`/`or`/`not`, "
            "`a if c else b`, and the functions abs, sqrt, exp, log, log10, sin, cos, tan, asin, acos, atan, "
            "atan2, sinh, cosh, tanh, min, max, floor, ceil, hypot, deg, rad, where(c, a, b), near(a, b) "
-           "(|a - b| ≤ 10⁻⁶ × model size).", ""]
+           "(|a - b| ≤ 10⁻⁶ × model size); a selection (`where`) must be a condition, e.g. `x > 0` or `near(x, 0)`, "
+           "not a number.",
+           "",
+           "Units: layershell has no unit system of its own; give every value in one consistent set (e.g. kN and m, "
+           "so stresses in kN/m²). The meanings name the kind of quantity: (length), (force/area), (force), "
+           "(degrees). Types: *number* is a decimal or whole number, *integer* a whole number, *condition* a "
+           "formula that is true or false at each point; *not set* means the key may be left out.", ""]
     for title, cls, text in SECTIONS:
         out += [f"## `{title}`", "", text, "", "| key | type | default | meaning |", "|---|---|---|---|"]
         for name, fld in cls.model_fields.items():
             if name == "type":
                 continue
-            default = "required" if fld.is_required() else repr(fld.get_default(call_default_factory=True))
             desc = (fld.description or "").replace("|", "\\|")
-            out.append(f"| `{name}` | {_type(fld.annotation)} | {default} | {desc} |".replace("\n", " "))
+            kind = _key_type(cls, name, fld).replace("|", "\\|")
+            out.append(f"| `{name}` | {kind} | {_default(fld)} | {desc} |".replace("\n", " "))
         out.append("")
     return "\n".join(out) + "\n"
 

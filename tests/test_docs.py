@@ -16,6 +16,59 @@ def test_model_file_reference_is_up_to_date():
         "run: python docs/gen_model_file_doc.py"
 
 
+def _tables() -> list:
+    """Every table (pydantic model) a model file can contain, reached from ModelFile's keys."""
+    import typing
+
+    from pydantic import BaseModel
+
+    from layershell.io import schema
+
+    def walk(tp, seen):
+        if isinstance(tp, type) and issubclass(tp, BaseModel):
+            if tp not in seen:
+                seen.append(tp)
+                for f in tp.model_fields.values():
+                    walk(f.annotation, seen)
+        for a in typing.get_args(tp):
+            walk(a, seen)
+        return seen
+
+    return walk(schema.ModelFile, [])[1:]
+
+
+def test_every_key_has_a_meaning():
+    """Issue 15: the reference gives a one-line meaning for every key of every table."""
+    missing = [f"{cls.__name__}.{name}" for cls in _tables() for name, f in cls.model_fields.items()
+               if name != "type" and not (f.description or "").strip()]
+    assert not missing, f"add description= to these fields in io/schema.py: {missing}"
+
+
+def test_every_table_is_in_the_reference():
+    sys.path.insert(0, str(ROOT / "docs"))
+    import gen_model_file_doc
+
+    documented = {cls for _, cls, _ in gen_model_file_doc.SECTIONS}
+    missing = [cls.__name__ for cls in _tables() if cls not in documented]
+    assert not missing, f"add these tables to SECTIONS in docs/gen_model_file_doc.py: {missing}"
+
+
+def test_reference_types_are_readable():
+    """No pydantic/typing reprs such as Optional[list[float], FieldInfo(annotation=none, ...MinLen...)]."""
+    text = (ROOT / "docs" / "model-file.md").read_text(encoding="utf-8")
+    for raw in ("FieldInfo", "typing", "Annotated", "Optional[", "Union[", "<class", "layershell.io", "MinLen",
+                "Gt(", "NoneType"):
+        assert raw not in text, raw
+    for raw in (r"\bfloat\b", r"\bint\b", r"\bstr\b", r"\bNone\b", r"\bTrue\b"):
+        assert not re.search(raw, text), raw
+    rows = [r for r in text.splitlines() if r.startswith("| `")]
+    assert len(rows) >= 150
+    kinds = {r.split(" | ")[1] for r in rows}
+    for expected in ("list of 3 numbers", "number > 0", 'list of "x", "y", "z"', 'one of "+z", "-z"',
+                     "number or formula in x, y, z", "integer from 0 to 4", "condition in x, y, z", "true/false"):
+        assert expected in kinds, (expected, sorted(kinds))
+
+
 def test_readme_python_quick_start_runs(tmp_path, monkeypatch):
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     code = re.findall(r"```python\n(.*?)```", text, re.S)[0]
@@ -32,6 +85,30 @@ def test_readme_shows_the_two_commands():
     text = (ROOT / "README.md").read_text(encoding="utf-8")
     assert "make demo" in text and "make test" in text
     assert os.access(ROOT / ".ci" / "run", os.X_OK)
+
+
+def test_quick_start_puts_layershell_on_path():
+    """The quick start types `layershell` bare: it first activates the environment that `make demo`
+    installs into, and `make demo` itself ends by saying how (issue 15)."""
+    import shutil
+    import subprocess
+
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    block = re.search(r"## Quick start\n\n```bash\n(.*?)```", text, re.S).group(1).splitlines()
+    bare = [i for i, line in enumerate(block) if line.startswith("layershell ")]
+    activate = [i for i, line in enumerate(block) if line.startswith("source .venv/bin/activate")]
+    assert bare and activate and activate[0] < bare[0], block
+    if shutil.which("make"):
+        dry = subprocess.run(["make", "-n", "demo"], cwd=ROOT, capture_output=True, text=True, timeout=60)
+        assert "source .venv/bin/activate" in dry.stdout, dry.stdout + dry.stderr
+    if sys.prefix != sys.base_prefix and os.name == "posix" and shutil.which("bash"):
+        # in a virtual environment (make test uses .venv): its activate script puts layershell on PATH
+        env = {k: v for k, v in os.environ.items() if k != "VIRTUAL_ENV"}
+        env["PATH"] = "/usr/bin:/bin"
+        found = subprocess.run(["bash", "-c", f'source "{sys.prefix}/bin/activate" && command -v layershell'],
+                               capture_output=True, text=True, env=env, timeout=60)
+        assert found.returncode == 0, found.stderr
+        assert Path(found.stdout.strip()).resolve() == (Path(sys.prefix) / "bin" / "layershell").resolve()
 
 
 def test_user_guide_refers_to_existing_files():

@@ -83,6 +83,8 @@ def _load(model: Path):
         spec = load(model)
         for note in spec.model.mesh.notes:  # e.g. quad4/quad8 converted to quad9
             err.print(f"note: {escape(note)}", highlight=False, soft_wrap=True)
+        for text in spec.warnings:  # valid but almost surely not meant (e.g. no loads)
+            err.print(f"warning: {escape(f'{spec.path}: {text}')}", highlight=False, soft_wrap=True)
         return spec
     except InputError as exc:
         _fail(str(exc))
@@ -430,7 +432,12 @@ def sweep(
             err.print(f"variant {rec['index']}: {escape(str(rec['values']))} {state} ({rec.get('wall_seconds')} s)",
                       highlight=False, soft_wrap=True)
 
-    res = _guarded(f"sweep of {model}", run_sweep, model, pairs, out_dir, jobs, vtu, progress)
+    from rich.progress import Progress
+
+    with Progress(console=err, disable=quiet, transient=True) as checks:  # validation of many variants
+        task = checks.add_task("checking the variants", total=None)
+        res = _guarded(f"sweep of {model}", run_sweep, model, pairs, out_dir, jobs, vtu, progress,
+                       lambda i, n: checks.update(task, completed=i, total=n, visible=i < n))
     if not quiet:
         table = Table(title=f"{model.name}: {len(res.rows)} variant(s) — {res.out / 'sweep.csv'}")
         shown = [h for h in res.header if h not in ("folder", "error", "wall_seconds")]

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import math
 import os
 import tomllib
 from concurrent.futures import ProcessPoolExecutor
@@ -144,7 +145,7 @@ def read_model(path: str | Path) -> dict:
     if not path.is_file():
         raise _input_error(f"model file '{path}' does not exist; check the path (examples are in examples/)")
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8"))
+        return tomllib.loads(path.read_text(encoding="utf-8").removeprefix("\ufeff"))  # BOM: not TOML
     except (tomllib.TOMLDecodeError, UnicodeDecodeError) as exc:
         raise _input_error(f"{path}: not valid TOML/UTF-8: {exc}; run `layershell check {path}`") from None
 
@@ -183,6 +184,11 @@ def describe(values: dict[str, Any]) -> str:
     return ", ".join(f"{k}={_fmt(v)}" for k, v in values.items())
 
 
+#: most variants of one sweep: every variant is validated and built before the first is solved
+#: (about 2 ms each for a small model), and each writes its own results folder
+MAX_VARIANTS = 10_000
+
+
 def variants(data: dict, sets: list[tuple[str, list[Any]]]) -> list[dict[str, Any]]:
     """The Cartesian product of the ``--set`` lists as ``[{key: value}, ...]`` (paths checked)."""
     keys = [k for k, _ in sets]
@@ -190,6 +196,12 @@ def variants(data: dict, sets: list[tuple[str, list[Any]]]) -> list[dict[str, An
     if dup:
         raise _input_error(f"--set: the key(s) {sorted(dup)} are given more than once; list all values of a key "
                            "in one --set KEY=V1,V2")
+    count = math.prod(len(v) for _, v in sets)
+    if count > MAX_VARIANTS:
+        sizes = " × ".join(f"{len(v)} ({k})" for k, v in sets)
+        raise _input_error(f"--set: the product of the value lists gives {count:,} variants ({sizes}), more than "
+                           f"the {MAX_VARIANTS:,} one sweep runs (each is validated, solved and written to its own "
+                           "folder); use fewer values per --set, or split the study into several sweeps with --out")
     probe = copy.deepcopy(data)
     for k, vals in sets:
         set_path(probe, k, vals[0])  # InputError naming the key when a parent does not exist
@@ -246,12 +258,14 @@ def run_variant(index: int, values: dict[str, Any], data: dict, base: str, out: 
 
 
 def sweep(model: str | Path, sets: list[tuple[str, list[Any]]], out: str | Path, jobs: int | None = None,
-          vtu: bool = False, progress: Callable[[dict], None] | None = None) -> SweepResult:
+          vtu: bool = False, progress: Callable[[dict], None] | None = None,
+          checking: Callable[[int, int], None] | None = None) -> SweepResult:
     """Run every combination of ``sets`` (``[(dotted key, [values])]``) and write ``out/sweep.csv``.
 
     All variants are validated and built before any is solved, so bad input fails fast
     (InputError naming the key and the variant). Variants run in ``jobs`` processes (default:
-    the number of CPU cores); each writes its results into ``out/vNNN/``."""
+    the number of CPU cores); each writes its results into ``out/vNNN/``. ``checking(i, n)`` is
+    called after each of the n variants is validated (progress of a long validation)."""
     from .io.output import write_csv, write_json
 
     model = Path(model)
@@ -264,6 +278,8 @@ def sweep(model: str | Path, sets: list[tuple[str, list[Any]]], out: str | Path,
         d = with_values(data, vals)
         build_spec(d, model.parent, f"{model}: variant {i} (--set {describe(vals)})")
         docs.append(d)
+        if checking:
+            checking(i + 1, len(combos))
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     keys = [k for k, _ in sets]

@@ -41,6 +41,7 @@ class RunSpec:
     source: schema.ModelFile
     path: Path | None = None
     profiles: list = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # input that is valid but almost surely not meant
 
 
 def _fmt_loc(loc) -> str:
@@ -196,6 +197,7 @@ def _validation_message(exc: ValidationError, limit: int = 8) -> str:
 
 
 def parse(text: str, name: str = "model file") -> schema.ModelFile:
+    text = text.removeprefix("\ufeff")  # a UTF-8 byte-order mark (Windows editors) is not part of the TOML
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -240,14 +242,36 @@ def _field_fn(value, field: str, variables=XYZ):
     return lambda **kw: f(**kw)
 
 
+def _span(x: np.ndarray) -> str:
+    """The coordinate ranges of points ``x (n, 3)``: 'x ∈ [0, 10], y ∈ [...], z ∈ [...]'."""
+    lo, hi = x.min(0), x.max(0)
+    return ", ".join(f"{c} ∈ [{a:.6g}, {b:.6g}]" for c, a, b in zip(XYZ, lo, hi))
+
+
+def _condition(m: meshmod.Mesh, where: str, field: str, x: np.ndarray) -> np.ndarray:
+    """A selection formula evaluated at the points ``x (n, 3)``: a boolean mask.
+
+    The formula must be a condition (a comparison, near(...), and/or/not): a number such as
+    ``where = "x"`` is an error, not 'true where non-zero'."""
+    f = _formula(where, XYZ, field)
+    try:
+        v = np.asarray(f(tol=1e-6 * m.size(), x=x[:, 0], y=x[:, 1], z=x[:, 2]))
+    except FormulaError as exc:
+        raise InputError(f"'{field}': {exc}") from None
+    if v.dtype != bool:
+        raise InputError(f"'{field}': '{where}' is a number, not a condition; a selection must be true or false at "
+                         "each point: compare coordinates, e.g. 'x > 0', 'near(x, 0)' (equal within a tolerance) or "
+                         "'0 < y and y < 2', and combine with and/or/not")
+    return np.broadcast_to(v, (x.shape[0],))
+
+
 def _node_selection(m: meshmod.Mesh, sel, field: str, required: bool = True) -> np.ndarray:
     where, set_, point = getattr(sel, "where", None), getattr(sel, "set", None), getattr(sel, "point", None)
     given = [g for g in (where, set_, point) if g is not None]
     if len(given) != 1:
         raise InputError(f"'{field}': give exactly one of 'where', 'set' or 'point' to select nodes")
     x = m.nodes
-    lo, hi = x.min(0), x.max(0)
-    span = ", ".join(f"{c} ∈ [{a:.6g}, {b:.6g}]" for c, a, b in zip(XYZ, lo, hi))
+    span = _span(x)
     if point is not None:
         diff = x - np.asarray(point, float)
         big = float(np.abs(diff).max(initial=0.0))
@@ -262,12 +286,7 @@ def _node_selection(m: meshmod.Mesh, sel, field: str, required: bool = True) -> 
                              f"available: {sorted(m.node_sets) or 'none'}")
         nodes = np.asarray(m.node_sets[set_])
     else:
-        f = _formula(where, XYZ, f"{field}.where")
-        try:
-            mask = np.broadcast_to(f(tol=1e-6 * m.size(), x=x[:, 0], y=x[:, 1], z=x[:, 2]), (m.n_nodes,))
-        except FormulaError as exc:
-            raise InputError(f"'{field}.where': {exc}") from None
-        nodes = np.flatnonzero(mask)
+        nodes = np.flatnonzero(_condition(m, where, f"{field}.where", x))
     if required and nodes.size == 0:
         raise InputError(f"'{field}': the selection '{where or set_}' selects no node; the model spans {span} "
                          "(use near(x, value) to compare coordinates with a tolerance)")
@@ -284,15 +303,9 @@ def _element_selection(m: meshmod.Mesh, sel, field: str) -> np.ndarray:
                              f"available: {sorted(m.element_sets) or 'none'}")
         return np.asarray(m.element_sets[set_])
     c = m.nodes[m.elements[:, 8]]
-    f = _formula(where, XYZ, f"{field}.where")
-    try:
-        el = np.flatnonzero(np.broadcast_to(f(tol=1e-6 * m.size(), x=c[:, 0], y=c[:, 1], z=c[:, 2]),
-                                            (m.n_elements,)))
-    except FormulaError as exc:
-        raise InputError(f"'{field}.where': {exc}") from None
+    el = np.flatnonzero(_condition(m, where, f"{field}.where", c))
     if el.size == 0:
-        lo, hi = c.min(0), c.max(0)
-        span = ", ".join(f"{n} ∈ [{a:.6g}, {b:.6g}]" for n, a, b in zip(XYZ, lo, hi))
+        span = _span(c)
         raise InputError(f"'{field}.where': '{where}' selects no element (it is tested at the element centres, "
                          f"which span {span}); widen the condition or use near(x, value)")
     return el
@@ -628,6 +641,53 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
                                              d.max_debond_fraction, d.max_debond_cuts, d.reequilibrate)
 
 
+def _zero_load(ld) -> bool:
+    """A load whose value is the number 0 (formulas and other load types: not known to be zero)."""
+    value = {"surface": "magnitude", "edge": "distribution", "volume": "value", "nodal": "value"}.get(ld.type)
+    v = getattr(ld, value, None) if value else None
+    if isinstance(v, (int, float)):
+        return v == 0
+    return isinstance(v, list) and all(isinstance(c, (int, float)) and c == 0 for c in v)
+
+
+def _check_gravity(model: Model, el: np.ndarray, g: np.ndarray, field: str) -> None:
+    """A gravity load acts on the density of the layers: with g = 0 or no mass it is silently zero."""
+    if not np.abs(g).max() > 0:
+        raise InputError(f"'{field}.g': the gravity vector is {g.tolist()}, so the load is "
+                         "zero; give the acceleration of gravity as a non-zero vector, e.g. g = [0, 0, -9.81]")
+    present = {k for s in np.unique(model.element_stack[el]) for k in model.stacks[s]}
+    if not any(model.layers[k].material.density > 0 for k in present):
+        mats = sorted({model.layers[k].material.name for k in present})
+        raise InputError(f"'{field}': a gravity load acts on the materials' density, but every layer it loads "
+                         f"({', '.join(repr(model.layers[k].name) for k in sorted(present))}) is made of material(s) "
+                         f"with density 0 ({', '.join(repr(n) for n in mats)}), so the load is zero; give "
+                         f"'density' (mass per volume, in the model's units) in [materials.{mats[0]}], or remove "
+                         "the gravity load")
+
+
+#: largest total thickness of the laminate, as a fraction of the model size (bounding-box diagonal)
+MAX_THICKNESS_RATIO = 1.0
+
+
+def _check_slender(model: Model) -> None:
+    """A shell is thin compared with its extent: a laminate thicker than the whole model is a unit
+    mistake (mm vs m), and its stiffness is singular or meaningless, which the solver would
+    otherwise report as free rigid-body motions of the supports."""
+    tot = model.total_thickness()
+    size = model.mesh.size()
+    j = int(np.argmax(tot))
+    if tot[j] > MAX_THICKNESS_RATIO * size:
+        stacks = np.unique(model.element_stack[np.any(model.mesh.elements == j, axis=1)])
+        present = sorted({k for s in stacks for k in model.stacks[s]})
+        k = max(present, key=lambda i: model.layers[i].thickness[j])
+        ly = model.layers[k]
+        raise InputError(f"'layers[{k}].thickness': the laminate is {tot[j]:.6g} thick at node {j} "
+                         f"{model.mesh.nodes[j].round(6).tolist()} (layer '{ly.name}': {ly.thickness[j]:.6g}), more than "
+                         f"the size of the whole model ({size:.6g}, the diagonal of the mesh's bounding box); a "
+                         "shell must be thin compared with its span: check the units of the thickness and of the "
+                         "mesh (e.g. mm against m, or the mesh file's 'scale')")
+
+
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -677,21 +737,42 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         element_stack = np.zeros(m.n_elements, np.int64)
     else:
         stacks, element_stack = [], np.full(m.n_elements, -1, np.int64)
+        rest = [i for i, sd in enumerate(mf.stacks) if sd.where is None and sd.set is None]
+        if len(rest) > 1:
+            raise InputError(f"'stacks': stacks {rest} all have neither 'where' nor 'set', so each would take "
+                             "every element not selected by another stack; keep one such stack (the rest of the "
+                             "shell) and give the others a 'where' or 'set'")
         for i, sd in enumerate(mf.stacks):
             st = tuple(layer_idx(n, f"stacks[{i}].layers") for n in sd.layers)
-            el = _element_selection(m, sd, f"stacks[{i}]")
             stacks.append(st)
+            if i in rest:
+                continue
+            el = _element_selection(m, sd, f"stacks[{i}]")
+            taken = el[element_stack[el] >= 0]
+            if taken.size:
+                j = int(element_stack[taken[0]])
+                c = m.nodes[m.elements[taken[0], 8]].round(6).tolist()
+                sel = lambda s: f"where = '{s.where}'" if s.where is not None else f"set = '{s.set}'"  # noqa: E731
+                raise InputError(f"'stacks[{i}]': {taken.size} element(s) selected by stacks[{i}] "
+                                 f"({sel(sd)}) are also selected by stacks[{j}] ({sel(mf.stacks[j])}), e.g. "
+                                 f"element {taken[0]} with centre {c}; every element carries exactly one stack: "
+                                 "make the selections disjoint (e.g. 'y < 2' and 'y >= 2'), or leave one stack "
+                                 "without 'where' and 'set' to take the remaining elements")
             element_stack[el] = i
+        if rest:
+            element_stack[element_stack < 0] = rest[0]
         if np.any(element_stack < 0):
             bad = np.flatnonzero(element_stack < 0)
             raise InputError(f"'stacks': {bad.size} element(s) belong to no stack (first: element {bad[0]}); "
-                             "add a stack without 'where' or widen the selections")
+                             "add a stack without 'where' and 'set' (it takes the remaining elements) or widen "
+                             "the selections")
     model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
                   nonlinear=mf.model.nonlinear, units=mf.model.units)
     try:
         model.below()
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
+    _check_slender(model)
     first = stacks[0][0]
     if mf.mesh.surface == "middle":
         m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)
@@ -753,6 +834,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             else:
                 g = np.asarray(ld.g, float)
                 gn = np.linalg.norm(g)
+                _check_gravity(model, el, g, f)
                 for k, ly in enumerate(layers):
                     if ly.material.density > 0 and gn > 0:
                         w = ly.material.density * gn
@@ -804,6 +886,13 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                 raise InputError(f"'{f}.director': layer '{layers[k].name}' has directors 0..{layers[k].directors}")
             model.nodal_loads.append(NodalLoad(nodes, k, ld.director, np.asarray(ld.value, float), ld.scaled))
 
+    notes = []
+    if not mf.loads:
+        notes.append("the model has no [[loads]], so every displacement, stress and probe value is zero; add a "
+                     "[[loads]] table (type = 'surface', 'edge', 'volume', 'gravity' or 'nodal'), see examples/")
+    elif all(_zero_load(ld) for ld in mf.loads):
+        notes.append("every [[loads]] entry is zero (magnitude, distribution or value 0), so every displacement, "
+                     "stress and probe value is zero; give the loads their values")
     st = mf.steps
     if st.factors is not None:
         lf = np.asarray(st.factors, float)
@@ -822,11 +911,19 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
 
     probes = build_probes(mf, model, index, _node_selection)
     for i, pr in enumerate(mf.profiles):
+        from ..results import locate
         from .probes import STRESS_COMPONENTS
+
+        dist = locate(model, pr.point)[3]
+        if not dist <= 1e-3 * m.size():
+            raise InputError(f"'profiles[{i}].point': {pr.point} is {dist:.4g} away from the reference surface of "
+                             f"the shell (the mesh spans {_span(m.nodes)}); give a point on the reference surface "
+                             "(Θ³ = 0): the profile runs through the thickness from there")
 
         if pr.component not in (*STRESS_COMPONENTS, "p1", "p2", "p3", "von_mises"):
             raise InputError(f"'profiles[{i}].component': '{pr.component}' is not a stress component; use one of "
                              f"{[*STRESS_COMPONENTS, 'p1', 'p2', 'p3', 'von_mises']}")
     spec = RunSpec(model, lf, newton, probes, mf.output, mf)
     spec.profiles = list(mf.profiles)
+    spec.warnings = notes
     return spec

@@ -3,7 +3,8 @@
 Gmsh physical groups (``cell_sets``) become named sets: the nodes of every group are a node set,
 and the quadrilaterals of a surface group an element set. 8-node and 4-node quadrilaterals are
 converted to 9-node elements (centre and mid-side nodes added on straight lines / the serendipity
-interpolation), with a note in ``Mesh.notes``.
+interpolation), with a note in ``Mesh.notes``. Triangles (or other polygons) next to the
+quadrilaterals are an error, never dropped.
 """
 from __future__ import annotations
 
@@ -58,6 +59,18 @@ def read_mesh(path: str | Path, scale: float = 1.0) -> Mesh:
         raise MeshError(f"mesh file '{path}' has no quadrilateral cells (found: "
                         f"{sorted({cb.type for cb in m.cells})}); layershell needs 9-node quadrilaterals "
                         "(Gmsh: Mesh.ElementOrder = 2, Mesh.RecombineAll = 1, Mesh.SecondOrderIncomplete = 0)")
+    others = {}  # surface cells that are not quadrilaterals: a mesh must not lose them silently
+    for cb in m.cells:
+        if cb.type.startswith(("triangle", "polygon")):
+            others[cb.type] = others.get(cb.type, 0) + len(cb.data)
+    if others:
+        found = ", ".join(f"{n} '{t}'" for t, n in others.items())
+        quads = sum(len(cb.data) for _, cb in blocks)
+        raise MeshError(f"mesh file '{path}' has {found} cells besides its {quads} quadrilaterals; layershell needs "
+                        "a mesh of quadrilaterals only (9-node, or 4/8-node converted) and does not drop the other "
+                        "cells silently: recombine the whole surface into quadrilaterals (Gmsh: Mesh.RecombineAll "
+                        "= 1, Mesh.ElementOrder = 2, Mesh.SecondOrderIncomplete = 0, and if triangles remain "
+                        "Mesh.SubdivisionAlgorithm = 1)")
     points = np.asarray(m.points, float) * scale
     if points.shape[1] == 2:
         points = np.column_stack([points, np.zeros(len(points))])

@@ -275,6 +275,8 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
                 raise InputError(f"'{f}.point': {pd.point} is {dist:.4g} away from the reference surface; "
                                  "give a point on the reference surface (Θ³ = 0) and the height in theta3")
             el, xi, eta = np.array([e]), np.array([x]), np.array([y])
+        if not local:
+            _check_heights(model, f, el, xi, eta, th, k)
         P = el.size
         el_all = np.repeat(el, th.size)
         xi_all = np.repeat(xi, th.size)
@@ -363,6 +365,34 @@ def _sharing(model, point, e0: int, d0: float) -> tuple[np.ndarray, np.ndarray, 
     if not keep.any():
         return np.array([e0]), np.zeros(1), np.zeros(1)
     return cand[keep], x[keep, 0], x[keep, 1]
+
+
+def _check_heights(model, f: str, el, xi, eta, th, k: int | None) -> None:
+    """Θ³ of a probe must lie within the laminate (or the named layer) at its points: outside, the
+    director polynomials are extrapolated and give arbitrary values."""
+    from ..element.shape import quad9
+    from .errors import InputError
+
+    N = quad9(np.asarray(xi, float), np.asarray(eta, float))[0]  # (P, 9)
+    conn = model.mesh.elements[el]
+    stk = model.element_stack[el]
+    lo, hi = np.full(el.size, -np.inf), np.full(el.size, np.inf)
+    for s in np.unique(stk):
+        st, sel = model.stacks[s], stk == s
+        if k is not None and k not in st:
+            continue
+        lo_k, hi_k = (st[0], st[-1]) if k is None else (k, k)
+        lo[sel] = np.einsum("pa,pa->p", N[sel], model.offset(lo_k)[conn[sel]])
+        hi[sel] = np.einsum("pa,pa->p", N[sel], (model.offset(hi_k) + model.layers[hi_k].thickness)[conn[sel]])
+    tol = 1e-6 * np.abs(hi[np.isfinite(hi)]).max(initial=0.0)
+    out = (th[None, :] < lo[:, None] - tol) | (th[None, :] > hi[:, None] + tol)
+    if out.any():
+        p, t = np.argwhere(out)[0]
+        X = (N[p] @ model.mesh.nodes[conn[p]]).round(6).tolist()
+        what = "the laminate" if k is None else f"layer '{model.layers[k].name}'"
+        raise InputError(f"'{f}.theta3': Θ³ = {th[t]:.6g} lies outside the shell at the probe point {X}, where "
+                         f"{what} spans Θ³ = {lo[p]:.6g} to {hi[p]:.6g} (Θ³ is measured from the reference face); "
+                         "values outside the thickness would be extrapolated, so give a height within it")
 
 
 def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:

@@ -15,6 +15,14 @@ from pydantic import (BaseModel, ConfigDict, Field, FiniteFloat, PositiveFloat, 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 NumOrFormula = Union[float, str]
 
+#: descriptions shared by many tables
+_NODES = "the nodes where this condition holds (near(x, 0) compares within 10⁻⁶ × the model size)"
+_ELEMS = "the elements whose centre satisfies this condition; default: all elements"
+_SET_N = "named node set (mesh edges such as xmin, ymax, or a mesh file's physical group)"
+_SET_E = "named element set (a mesh file's surface group or a revolution segment's set)"
+_POINT = "[x, y, z]: the node nearest to this point"
+_SCALED = "multiplied by the load factor λ (false: a constant load, present from the first step)"
+
 
 def _leaf_types(tp) -> set:
     args = get_args(tp)
@@ -55,7 +63,7 @@ class Strict(BaseModel):
 
 # ------------------------------------------------------------------ general settings
 class ModelSettings(Strict):
-    title: str = ""
+    title: str = Field("", description="title shown in the report and the figures")
     units: str = Field("", description="unit system, for reports only (e.g. 'kN, m')")
     nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
     thickness_points: PositiveInt = Field(
@@ -75,11 +83,11 @@ class MeshBase(Strict):
 
 class RectangleMesh(MeshBase):
     type: Literal["rectangle"]
-    lx: PositiveFloat
-    ly: PositiveFloat
-    nx: PositiveInt
-    ny: PositiveInt
-    origin: Vec3 = [0.0, 0.0, 0.0]
+    lx: PositiveFloat = Field(description="length along x (length)")
+    ly: PositiveFloat = Field(description="length along y (length)")
+    nx: PositiveInt = Field(description="elements along x")
+    ny: PositiveInt = Field(description="elements along y")
+    origin: Vec3 = Field([0.0, 0.0, 0.0], description="[x, y, z] of the corner with the smallest x and y (length)")
     normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
     grading_x: PositiveFloat = Field(
         1.0, ge=1e-4, le=1e4, description="size of the last element along x over the first (geometric grading; > 1 refines "
@@ -89,15 +97,17 @@ class RectangleMesh(MeshBase):
 
 class CylinderMesh(MeshBase):
     type: Literal["cylinder"]
-    radius: PositiveFloat = Field(description="radius of the reference face")
-    angle_start: float = 0.0
-    angle_end: float = Field(description="degrees")
-    width: PositiveFloat
-    n_arc: PositiveInt
-    n_width: PositiveInt = 1
+    radius: PositiveFloat = Field(description="radius of the reference face (length)")
+    angle_start: float = Field(0.0, description=(
+        "angle of the first edge (degrees, from +x towards +y; axis y: towards +z)"))
+    angle_end: float = Field(description="angle of the last edge (degrees); |angle_end - angle_start| ≤ 360")
+    width: PositiveFloat = Field(description="length along the axis (length)")
+    n_arc: PositiveInt = Field(description="elements along the arc")
+    n_width: PositiveInt = Field(1, description="elements along the axis")
     normal: Literal["inward", "outward"] = Field(
         "inward", description="'inward': reference face outside (A3 towards the axis)")
-    axis: Literal["z", "y"] = "z"
+    axis: Literal["z", "y"] = Field("z", description=(
+        "cylinder axis: 'z' (arc in the x-y plane) or 'y' (arc in the x-z plane)"))
 
     @model_validator(mode="after")
     def _span(self):
@@ -118,13 +128,16 @@ class MeridianSegment(Strict):
 
 class RevolutionMesh(MeshBase):
     type: Literal["revolution"]
-    meridian_r: list[float] = Field(min_length=2)
-    meridian_z: list[float] = Field(min_length=2)
+    meridian_r: list[float] = Field(min_length=2, description=(
+        "distances r ≥ 0 of the meridian points from the z axis (length)"))
+    meridian_z: list[float] = Field(min_length=2, description="heights z of the meridian points (length)")
     n_meridian: PositiveInt | None = Field(
         None, description="elements of equal length along the meridian polyline (or give 'segments')")
-    n_circ: PositiveInt
-    angle: float = Field(360.0, gt=0, le=360)
-    normal: Literal["inward", "outward"] = "outward"
+    n_circ: PositiveInt = Field(description="elements around the axis")
+    angle: float = Field(360.0, gt=0, le=360, description="angle of revolution (degrees); 360: closed")
+    normal: Literal["inward", "outward"] = Field("outward", description=(
+        "side of the reference face's normal A3 (where the material lies): 'outward' away from the axis / upward "
+        "on a cap"))
     segments: list[MeridianSegment] | None = Field(
         None, description="one per pair of consecutive meridian points: {elements, set, arc_center}")
     meridian_thickness: list[PositiveFloat] | None = Field(
@@ -157,7 +170,7 @@ class RevolutionMesh(MeshBase):
 class FileMesh(MeshBase):
     type: Literal["file"]
     path: str = Field(description="mesh file read with meshio (Gmsh .msh, .vtu, ...), relative to the model file")
-    scale: PositiveFloat = 1.0
+    scale: PositiveFloat = Field(1.0, description="factor on the file's coordinates (e.g. 0.001: mm → m)")
 
 
 Mesh = Annotated[Union[RectangleMesh, CylinderMesh, RevolutionMesh, FileMesh], Field(discriminator="type")]
@@ -166,22 +179,23 @@ Mesh = Annotated[Union[RectangleMesh, CylinderMesh, RevolutionMesh, FileMesh], F
 # ------------------------------------------------------------------ materials and layers
 class Isotropic(Strict):
     type: Literal["isotropic"]
-    E: float
-    nu: float
+    E: float = Field(description="Young's modulus (force/area)")
+    nu: float = Field(description="Poisson's ratio, -1 < nu < 0.5")
     density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
 
 class OrthotropicMat(Strict):
     type: Literal["orthotropic"]
-    E1: float
-    E2: float
-    E3: float
-    G12: float
-    G23: float
-    G31: float
-    nu12: float
-    nu23: float
-    nu31: float | None = None
+    E1: float = Field(description="Young's modulus along material axis 1 (force/area)")
+    E2: float = Field(description="Young's modulus along material axis 2 (force/area)")
+    E3: float = Field(description="Young's modulus along the normal, axis 3 (force/area)")
+    G12: float = Field(description="in-plane shear modulus (force/area)")
+    G23: float = Field(description="transverse shear modulus in the 2-3 plane (force/area)")
+    G31: float = Field(description="transverse shear modulus in the 3-1 plane (force/area)")
+    nu12: float = Field(description="Poisson's ratio: strain along 2 from stress along 1 is -nu12/E1")
+    nu23: float = Field(description="Poisson's ratio: strain along 3 from stress along 2 is -nu23/E2")
+    nu31: float | None = Field(None, description=(
+        "Poisson's ratio: strain along 1 from stress along 3 is -nu31/E3 (or give nu13)"))
     nu13: float | None = Field(None, description="give nu13 instead of nu31 (nu31 = nu13 E3/E1)")
     density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
@@ -197,10 +211,12 @@ Material = Annotated[Union[Isotropic, OrthotropicMat], Field(discriminator="type
 
 
 class LayerDef(Strict):
-    name: str = Field(min_length=1)
-    material: str
-    thickness: NumOrFormula = Field(description="number or formula in x, y, z (evaluated at the nodes)")
-    directors: int = Field(3, ge=0, le=4, description="d: u = Σ_{l=0..d} (Θ³)^l u_l")
+    name: str = Field(min_length=1, description="name of the layer, used by stacks, supports, loads and probes")
+    material: str = Field(description="name of a [materials.NAME] table")
+    thickness: NumOrFormula = Field(description=(
+        "layer thickness (length); a formula is evaluated at the nodes"))
+    directors: int = Field(3, ge=0, le=4, description=(
+        "polynomial order d of the displacement through the layer: u = Σ_{l=0..d} (Θ³)^l u_l"))
     angle: FiniteFloat = Field(0.0, description="material angle ω in degrees about the normal")
     direction: Vec3 | None = Field(None, description="global direction projected on the surface as material axis 1")
 
@@ -215,8 +231,10 @@ class LayerDef(Strict):
 
 class StackDef(Strict):
     layers: list[str] = Field(min_length=1, description="layer names from the reference face outward")
-    where: str | None = Field(None, description="formula on element centres selecting the elements")
-    set: str | None = None
+    where: str | None = Field(None, description=(
+        "the elements whose centre satisfies this condition; a stack without where and set takes the elements "
+        "of no other stack"))
+    set: str | None = Field(None, description=_SET_E)
 
 
 # ------------------------------------------------------------------ supports
@@ -225,9 +243,9 @@ Component = Literal["x", "y", "z"]
 
 class FixDef(Strict):
     type: Literal["fix"]
-    where: str | None = None
-    set: str | None = None
-    point: Vec3 | None = None
+    where: str | None = Field(None, description=_NODES)
+    set: str | None = Field(None, description=_SET_N)
+    point: Vec3 | None = Field(None, description=_POINT)
     layer: str | None = Field(
         None, description="layer name, or 'all': every layer at the nodes (a support through the whole thickness); "
                           "default: the layer at the reference face")
@@ -247,21 +265,24 @@ class FixDef(Strict):
 
 class SymmetryDef(Strict):
     type: Literal["symmetry"]
-    where: str | None = None
-    set: str | None = None
-    point: Vec3 | None = None
-    normal: Vec3
+    where: str | None = Field(None, description=_NODES)
+    set: str | None = Field(None, description=_SET_N)
+    point: Vec3 | None = Field(None, description=_POINT)
+    normal: Vec3 = Field(description=(
+        "normal of the symmetry plane [x, y, z] (any length): the displacement along it is zero for every "
+        "director and layer"))
 
 
 class HingeDef(Strict):
     type: Literal["hinge"]
-    where: str | None = None
-    set: str | None = None
-    point: Vec3 | None = None
+    where: str | None = Field(None, description=_NODES)
+    set: str | None = Field(None, description=_SET_N)
+    point: Vec3 | None = Field(None, description=_POINT)
     direction: Union[Vec3, Literal["edge-normal"]] = Field(
         description="hinge direction: a global vector (any, the thickness direction included) or 'edge-normal', the "
                     "in-plane normal of the boundary edge at each node (local direction, (3.84)-(3.90))")
-    height: float | None = Field(None, description="Θ³ of the hinge; default mid-thickness")
+    height: float | None = Field(None, description=(
+        "Θ³ of the hinge line (length, from the reference face); default: mid-thickness"))
     fixed: bool = Field(True, description="fixed hinge (u0 of the first layer along 'direction' only) or sliding")
 
 
@@ -272,54 +293,58 @@ Support = Annotated[Union[FixDef, SymmetryDef, HingeDef], Field(discriminator="t
 class SurfaceLoadDef(Strict):
     type: Literal["surface"]
     face: str = Field("reference", description="'reference', 'top' or 'layer:<name>' (bottom face of that layer)")
-    where: str | None = None
-    set: str | None = None
+    where: str | None = Field(None, description=_ELEMS)
+    set: str | None = Field(None, description=_SET_E)
     direction: Union[Vec3, Literal["normal"]] = Field(description="global vector or 'normal' (A3)")
-    magnitude: NumOrFormula = Field(description="force per reference area; number or formula in x, y, z")
-    scaled: bool = Field(True, description="multiplied by the load factor λ")
+    magnitude: NumOrFormula = Field(description=(
+        "force per reference area (force/area)"))
+    scaled: bool = Field(True, description=_SCALED)
 
 
 class EdgeLoadDef(Strict):
     type: Literal["edge"]
     where: str | None = Field(None, description="boundary edges whose three nodes satisfy this formula")
-    set: str | None = None
-    direction: Vec3
+    set: str | None = Field(None, description=_SET_N + "; the loaded edges are the boundary edges whose three "
+                            "nodes are in it")
+    direction: Vec3 = Field(description="global direction of the traction [x, y, z] (normalised)")
     distribution: NumOrFormula = Field(
-        description="traction per area through the thickness: formula in t (Θ³ from the reference face), x, y, z; "
-                    "with 'face': a line force per edge length on that face")
+        description="traction through the thickness (force/area), a number or a formula in t (Θ³ from the "
+                    "reference face), x, y, z; with 'face': a line force per edge length on that face")
     face: Literal["top", "reference"] | None = Field(
         None, description="apply a line force on the edge of the top (opposite) or reference face, (2.175)/(2.180)")
     height: float | None = Field(
         None, description="a line force per edge length at this Θ³ (from the reference face, length), split into "
                           "director forces (Θ_L³)^l q of the layer containing it (the upper one at an interface)")
-    scaled: bool = True
+    scaled: bool = Field(True, description=_SCALED)
 
 
 class VolumeLoadDef(Strict):
     type: Literal["volume"]
-    where: str | None = None
-    set: str | None = None
-    layer: str | None = None
-    value: Vec3 = Field(description="force per volume")
-    scaled: bool = True
+    where: str | None = Field(None, description=_ELEMS)
+    set: str | None = Field(None, description=_SET_E)
+    layer: str | None = Field(None, description="only this layer; default: every layer")
+    value: Vec3 = Field(description="force per volume [x, y, z] (force/length³)")
+    scaled: bool = Field(True, description=_SCALED)
 
 
 class GravityDef(Strict):
     type: Literal["gravity"]
-    where: str | None = None
-    set: str | None = None
-    g: Vec3 = [0.0, 0.0, -9.81]
-    scaled: bool = True
+    where: str | None = Field(None, description=_ELEMS)
+    set: str | None = Field(None, description=_SET_E)
+    g: Vec3 = Field([0.0, 0.0, -9.81], description=(
+        "acceleration of gravity [x, y, z] (length/time², in the units that make density × g a force per volume)"))
+    scaled: bool = Field(True, description=_SCALED)
 
 
 class NodalLoadDef(Strict):
     type: Literal["nodal"]
-    where: str | None = None
-    set: str | None = None
-    point: Vec3 | None = None
-    layer: str | None = None
-    director: int = Field(0, ge=0, le=4)
-    value: Vec3 = Field(description="force (director 0) or director force (force × length^director), global")
+    where: str | None = Field(None, description=_NODES)
+    set: str | None = Field(None, description=_SET_N)
+    point: Vec3 | None = Field(None, description=_POINT)
+    layer: str | None = Field(None, description=(
+        "layer whose director is loaded; default: the layer at the reference face"))
+    director: int = Field(0, ge=0, le=4, description="director l loaded (0: the layer's bottom face)")
+    value: Vec3 = Field(description="force [x, y, z] at each selected node (director 0), or director force (force × length^director), global")
     height: float | None = Field(
         None, description="Θ³ (from the reference face, length) at which the force acts, e.g. the mid-surface; it is "
                           "split into the director forces (Θ_L³)^l F of the layer containing it (the upper one at "
@@ -327,7 +352,7 @@ class NodalLoadDef(Strict):
     face: str | None = Field(
         None, description="'reference', 'top' or 'layer:<name>' (the bottom face of that layer): the force acts on "
                           "that face (split into director forces like 'height')")
-    scaled: bool = True
+    scaled: bool = Field(True, description=_SCALED)
 
 
 Load = Annotated[Union[SurfaceLoadDef, EdgeLoadDef, VolumeLoadDef, GravityDef, NodalLoadDef],
@@ -337,19 +362,25 @@ Load = Annotated[Union[SurfaceLoadDef, EdgeLoadDef, VolumeLoadDef, GravityDef, N
 # ------------------------------------------------------------------ stepping and probes
 class Steps(Strict):
     n: PositiveInt = Field(1, le=100_000, description="equal load steps from 0 to lambda_end")
-    lambda_end: FiniteFloat = 1.0
+    lambda_end: FiniteFloat = Field(1.0, description="load factor λ of the last step (the loads are λ × their values)")
     factors: list[float] | None = Field(None, description="explicit load factors (instead of n/lambda_end)")
-    tolerance: PositiveFloat = 1e-8
-    max_iterations: PositiveInt = Field(25, le=10_000)
-    max_bisections: int = Field(8, ge=0, le=30)
+    tolerance: PositiveFloat = Field(1e-8, description=(
+        "Newton convergence: residual norm ≤ tolerance × norm of the applied load vector λF (relative, "
+        "dimensionless)"))
+    max_iterations: PositiveInt = Field(25, le=10_000, description=(
+        "Newton iterations per load increment before it is bisected"))
+    max_bisections: int = Field(8, ge=0, le=30, description=(
+        "halvings of a load increment that does not converge before the run stops"))
     max_contact_iterations: PositiveInt = Field(
         100, le=100_000, description="models with contact: Newton iterations per equilibrium solve in all "
         "(semi-smooth and active-set loops) before the load increment is bisected")
-    solver: Literal["auto", "superlu", "pardiso"] = "auto"
+    solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
+        "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
 
 
 class ProbeDef(Strict):
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description=(
+        "column name in probes.csv and summary.json"))
     quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor", "reaction",
                       "resultant"] = Field(
         description="debonded_area: released area of the interface below `layer` (within `where`, a formula "
@@ -358,19 +389,24 @@ class ProbeDef(Strict):
                     "exert at the selected nodes (where/set/point), R = f_int − F_ext summed over the nodes' "
                     "rigid-body modes; resultant: stress resultant per unit width at `point`, integrated through "
                     "all layers (component n|m|q|nt|mt on the section whose normal is `direction`)")
-    point: Vec3 | None = Field(None, description="displacement: nearest node; stress: point on the reference surface")
+    point: Vec3 | None = Field(None, description=(
+        "displacement: the nearest node; stress, traction: a point on the reference surface"))
     where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area: "
                                                 "interface points counted")
-    set: str | None = None
+    set: str | None = Field(None, description="displacement: " + _SET_N)
     component: str | None = Field(
         None, description="displacement: x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises; "
                           "traction: 13|23|33|shear")
-    measure: Literal["cauchy", "pk2"] = "cauchy"
+    measure: Literal["cauchy", "pk2"] = Field("cauchy", description=(
+        "stress measure: Cauchy (true) or second Piola-Kirchhoff"))
     theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
-    layer: str | None = None
-    reduce: Literal["max", "min", "absmax", "mean", "none"] = "none"
-    scale: FiniteFloat = 1.0
+    layer: str | None = Field(None, description=(
+        "the layer meant (where theta3 lies on a layer boundary); traction and debonded_area: the layer above the "
+        "interface"))
+    reduce: Literal["max", "min", "absmax", "mean", "none"] = Field("none", description=(
+        "how the values at several nodes or heights become one number"))
+    scale: FiniteFloat = Field(1.0, description="factor on the value (e.g. -1 for a downward deflection)")
     direction: Vec3 | None = Field(
         None, description="resultant: normal of the section (a global vector, projected on the tangent plane); n, m: "
                           "normal force and moment of the stresses along it, q: transverse shear, nt/mt: in-plane "
@@ -408,50 +444,57 @@ class PlotDef(Strict):
 class ProfileDef(Strict):
     """Stress along the thickness at a point, one CSV column per layer, and a PNG plot."""
 
-    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$")
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description=(
+        "file names profile_<name>.csv / .png"))
     point: Vec3 = Field(description="point on the reference surface")
     component: str = Field("11", description="11|22|33|23|13|12|p1|p2|p3|von_mises")
-    measure: Literal["cauchy", "pk2"] = "cauchy"
-    points_per_layer: int = Field(21, ge=2, le=1001)
+    measure: Literal["cauchy", "pk2"] = Field("cauchy", description=(
+        "stress measure: Cauchy (true) or second Piola-Kirchhoff"))
+    points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer")
 
 
 class InitialZone(Strict):
     """Initially debonded region of an interface: nodes selected by a formula, a set, or a circle."""
 
-    where: str | None = None
-    set: str | None = None
+    where: str | None = Field(None, description=_NODES)
+    set: str | None = Field(None, description=_SET_N)
     circle: Annotated[list[float], Field(min_length=3, max_length=4)] | None = Field(
         None, description="[x, y, radius] (or [x, y, z, radius]) on the reference surface")
     mu0: float | None = Field(None, ge=0, le=1, description="friction in the zone (default: the interface's)")
-    mu: float | None = Field(None, gt=0, le=1)
-    gT_mu: Union[PositiveFloat, Literal["inf"]] | None = None
+    mu: float | None = Field(None, gt=0, le=1, description=(
+        "residual friction ratio in the zone (default: the interface's)"))
+    gT_mu: Union[PositiveFloat, Literal["inf"]] | None = Field(None, description=(
+        "slip of the residual friction in the zone (length; default: the interface's)"))
 
 
 class InterfaceDef(Strict):
     """Interface below layer ``layer`` (MODEL.md §9-§10)."""
 
     layer: str = Field(description="the layer above the interface")
-    sigma_max: PositiveFloat = Field(description="tensile strength σ33_max (4.15)")
-    tau_max: PositiveFloat = Field(description="shear strength τ_max (4.15)")
+    sigma_max: PositiveFloat = Field(description="tensile strength σ33_max (force/area, 4.15)")
+    tau_max: PositiveFloat = Field(description="shear strength τ_max (force/area, 4.15)")
     p: float = Field(2.0, ge=1.0, description="exponent of the failure surface (4.19)")
     mu0: float = Field(0.95, ge=0, le=1, description="friction right after fracture (4.70)")
     mu: float = Field(0.2, gt=0, le=1, description="residual friction ratio at g_T = gT_mu (4.77)")
-    gT_mu: Union[PositiveFloat, Literal["inf"]] = Field("inf", description="slip of the residual friction (4.76)")
+    gT_mu: Union[PositiveFloat, Literal["inf"]] = Field("inf", description=(
+        "slip of the residual friction (length, 4.76)"))
     mu_coulomb: float = Field(0.0, ge=0, description="Coulomb coefficient of the fallback (4.84)")
-    alpha_N: PositiveFloat | None = Field(None, description="normal contact penalty (default 100 E3/H_min)")
+    alpha_N: PositiveFloat | None = Field(None, description=(
+        "normal contact penalty (force/length³; default 100 E3/H_min)"))
     alpha_T: PositiveFloat | None = Field(
         None, description="tangential stick penalty of the regularised friction (default G13/H of the thinner layer)")
     open_gap: PositiveFloat | None = Field(
         None, description="a debonded point whose gap exceeds this is open: no friction there (default 0.1 × the "
                           "upper layer's thickness; an addition, the thesis's friction stops at any opening)")
-    initially_debonded: list[InitialZone] = []
+    initially_debonded: list[InitialZone] = Field([], description=(
+        "zones debonded from the start: {where | set | circle, mu0, mu, gT_mu}"))
 
 
 class DelaminationDef(Strict):
     friction: Literal["return_mapping", "explicit"] = Field(
         "return_mapping", description="friction as a penalty return mapping (implicit), or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
-    max_resolves: PositiveInt = 100
+    max_resolves: PositiveInt = Field(100, description="most re-solutions (release, solve again) per load step")
     max_debond_fraction: float | None = Field(
         None, gt=0, le=1,
         description="step cutting: a load increment whose re-solutions debond more than this fraction of the "
@@ -465,8 +508,8 @@ class DelaminationDef(Strict):
 
 
 class OutputDef(Strict):
-    vtu: bool = True
-    plots: bool = True
+    vtu: bool = Field(True, description="write the ParaView files (*.vtu, *.pvd)")
+    plots: bool = Field(True, description="write the PNG figures")
     every: PositiveInt = Field(1, description="write ParaView files every n-th step (the last is always written)")
     zone_steps: list[PositiveInt] | None = Field(
         None, description="load steps (1 = first, as in probes.csv) whose debonded zones are drawn in "
