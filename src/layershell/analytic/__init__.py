@@ -1,0 +1,1 @@
+"""Closed-form and semi-analytic reference solutions (independent of the finite elements)."""
