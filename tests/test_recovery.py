@@ -1,0 +1,144 @@
+"""Issue 14: recovered transverse stresses (layershell.recovery) against the exact 3D solution
+of a simply supported [0/90/0] plate under a double-sine load (layershell.analytic.pagano,
+itself checked in test_pagano.py)."""
+import numpy as np
+import pytest
+
+from layershell.analytic import pagano as pg
+from layershell.element.geometry import surface_points
+from layershell.element.quadrature import gauss_2d
+from layershell.material import Orthotropic
+from layershell.mesh import rectangle
+from layershell.model import Fix, Layer, Model, SurfaceLoad, Symmetry
+from layershell.recovery import Recovery, incidence, spr_operator
+from layershell.results import evaluate_points, locate
+from layershell.solver.newton import load_steps
+from layershell.solver.problem import Problem
+
+PLY = Orthotropic.from_nu13(25.0, 1.0, 1.0, 0.5, 0.2, 0.5, 0.25, 0.25, 0.25)  # Pagano (1970)
+HAS_MITC = "element" in getattr(Model, "__dataclass_fields__", {})
+
+
+def cross_ply_plate(s: float, n: int = 8, d: int = 3, h: float = 1.0, q0: float = 1.0):
+    """Quarter model (n × n, symmetry at x = y = a/2) of the simply supported square [0/90/0]
+    plate (a = s h, equal plies, d directors each) under the top pressure q0 sin(πx/a) sin(πy/a),
+    supported as in the 3D solution: w = 0 and the tangential displacement zero through the
+    whole thickness of the edges x = 0 and y = 0. Returns (model, problem, u, exact solution)."""
+    a = s * h
+    mesh = rectangle(a / 2, a / 2, n, n)
+    x = mesh.nodes
+    th = np.full(mesh.n_nodes, h / 3)
+    layers = [Layer(f"p{k}", PLY, d, th, ang) for k, ang in enumerate((0.0, 90.0, 0.0))]
+    e0, f0 = np.flatnonzero(np.isclose(x[:, 0], 0)), np.flatnonzero(np.isclose(x[:, 1], 0))
+    fixes = []
+    for k in range(3):  # u_0 of the upper layers follows from the bond
+        dirs = tuple(range(0 if k == 0 else 1, d + 1))
+        fixes += [Fix(e0, k, dirs, (1, 2)), Fix(f0, k, dirs, (0, 2))]
+    sym = [Symmetry(np.flatnonzero(np.isclose(x[:, 0], a / 2)), np.array([1.0, 0, 0])),
+           Symmetry(np.flatnonzero(np.isclose(x[:, 1], a / 2)), np.array([0, 1.0, 0]))]
+    load = SurfaceLoad(np.arange(mesh.n_elements), "top", np.array([0, 0, -1.0]),
+                       lambda x, y, z: q0 * np.sin(np.pi * x / a) * np.sin(np.pi * y / a))
+    m = Model(mesh, layers, [(0, 1, 2)], np.zeros(mesh.n_elements, int), fixes=fixes, symmetries=sym,
+              surface_loads=[load], nonlinear=False)
+    pb = Problem.build(m)
+    u = list(load_steps(pb, np.array([1.0])))[-1].u
+    exact = pg.solve([pg.ply_stiffness(PLY.stiffness(), g) for g in (0, 90, 0)], [h / 3] * 3, a, a, q0)
+    return m, pb, u, exact
+
+
+def _at(m, point, n=1):
+    e, xi, eta, _ = locate(m, point)
+    return np.full(n, e), np.full(n, xi), np.full(n, eta)
+
+
+@pytest.mark.parametrize("patch, degree", [("node", 2), ("vertex", 2), ("vertex", 3)])
+def test_patch_recovery_reproduces_complete_polynomials(patch, degree):
+    """Samples of a complete polynomial of the fitted degree at the Gauss points of a distorted
+    mesh are recovered exactly at every node (interior, edge, corner)."""
+    mesh = rectangle(2.0, 1.0, 8, 6)
+    rng = np.random.default_rng(0)
+    inner = (mesh.nodes[:, :2] > 1e-9) & (mesh.nodes[:, :2] < [2 - 1e-9, 1 - 1e-9])
+    mesh.nodes[:, :2] += 0.03 * rng.standard_normal((mesh.n_nodes, 2)) * inner
+    m = Model(mesh, [Layer("a", PLY, 1, np.full(mesh.n_nodes, 0.1))], [(0,)], np.zeros(mesh.n_elements, int))
+    R = spr_operator(m, incidence(m), np.ones(mesh.n_elements, bool), 3, degree, patch)
+    pts, _ = gauss_2d(3)
+    X = surface_points(mesh.nodes[mesh.elements], pts[:, 0], pts[:, 1]).X0.reshape(-1, 3)
+    f = lambda X: 1 + 2 * X[:, 0] - X[:, 1] + 0.5 * X[:, 0] ** 2 - X[:, 0] * X[:, 1] + 0.3 * X[:, 1] ** 2 \
+        + (degree == 3) * (0.2 * X[:, 0] ** 3 - 0.1 * X[:, 0] * X[:, 1] ** 2)
+    assert np.abs(R @ f(X) - f(mesh.nodes)).max() < 1e-11
+
+
+def _thin(s):
+    """a/h ≥ 20: the fully integrated element's in-plane stresses carry a locking oscillation
+    (linear within each element, ±13 on σ_yy ≈ 256 at a/h = 100) whose slope the recovery
+    integrates; the MITC9 element (issue 14 item 1) removes it."""
+    return pytest.mark.xfail(s >= 20 and not HAS_MITC, strict=True,
+                             reason="in-plane stresses of the fully integrated element oscillate (locking)")
+
+
+@pytest.mark.parametrize("s", [pytest.param(4, marks=pytest.mark.slow), 10,
+                               pytest.param(20, marks=[pytest.mark.slow, _thin(20)]),
+                               pytest.param(100, marks=[pytest.mark.slow, _thin(100)])])
+def test_cross_ply_plate_against_exact_3d_solution(s):
+    """[0/90/0], a/h = s, 8 × 8 quarter mesh, d = 3: mid-plane deflection within 0.5 %,
+    σxx (centre, top) and σyy (centre, top of the 90° ply) within 1 %, and the recovered τxz at
+    the edge x = 0 and τyz at the edge y = 0 within 2 % of the exact values at the two ply
+    interfaces (from both plies) and at mid-thickness; recovered σzz within 2 % of q0 at (a/4, a/4)."""
+    h, q0 = 1.0, 1.0
+    a = s * h
+    m, pb, u, ex = cross_ply_plate(s, h=h, q0=q0)
+    rec = Recovery(m, pb.dm)
+    c = _at(m, [a / 2, a / 2, 0])
+    w = evaluate_points(m, pb.dm, u, *c, [h / 2], [1]).u[0, 2]
+    assert abs(w / ex.fields(a / 2, a / 2, h / 2)["w"] - 1) < 0.005
+    sx = evaluate_points(m, pb.dm, u, *c, [h], [2]).pk2_physical[0, 0, 0]  # 0° ply: σ11 = σxx
+    assert abs(sx / ex.fields(a / 2, a / 2, h)["sxx"] - 1) < 0.01
+    sy = evaluate_points(m, pb.dm, u, *c, [2 * h / 3], [1]).pk2_physical[0, 0, 0]  # 90° ply: σ11 = σyy
+    assert abs(sy / ex.fields(a / 2, a / 2, 2 * h / 3)["syy"] - 1) < 0.01
+    z = np.array([h / 3, h / 3, h / 2, 2 * h / 3, 2 * h / 3])
+    lay = np.array([0, 1, 1, 1, 2])
+    for comp, point, i in (("txz", [0, a / 2, 0], 0), ("tyz", [a / 2, 0, 0], 1)):
+        el, xi, eta = _at(m, point, z.size)
+        ref = ex.fields(point[0], point[1], z)[comp]
+        got = rec.points(u, el, xi, eta, z, lay).S[:, i, 2]  # global components (flat plate)
+        err = np.abs(got / ref - 1)
+        assert err.max() < 0.02, (comp, err)
+    el, xi, eta = _at(m, [a / 4, a / 4, 0], z.size)  # away from the symmetry planes (see Recovery)
+    s33 = rec.points(u, el, xi, eta, z, lay).S[:, 2, 2]
+    assert np.abs(s33 - ex.fields(a / 4, a / 4, z)["szz"]).max() < 0.02 * q0
+
+
+def test_recovered_stresses_continuous_and_raw_ones_oscillate():
+    """At a/h = 10: the recovered σ13, σ23, σ33 agree from both sides of each ply interface; at a
+    node shared by four elements each element gives them within 2 % of the peak τxz (the
+    derivatives of the smoothed stresses jump between elements); the raw (Gauss-sampling)
+    τyz at the edge node is off by more than the recovered one; the faces carry the applied
+    tractions (zero shear, σzz = -q0 sin sin on top, 0 at the bottom)."""
+    s, h = 10, 1.0
+    a = s * h
+    m, pb, u, ex = cross_ply_plate(s, h=h)
+    rec = Recovery(m, pb.dm)
+    node = np.flatnonzero(np.isclose(m.mesh.nodes[:, 0], a / 8) & np.isclose(m.mesh.nodes[:, 1], a / 8))[0]
+    els = np.flatnonzero((m.mesh.elements == node).any(1))
+    assert els.size == 4
+    from layershell.element.shape import NODE_XI
+
+    loc = np.array([np.flatnonzero(m.mesh.elements[e] == node)[0] for e in els])
+    for k, zz in ((0, h / 3), (1, h / 3), (1, 2 * h / 3), (2, 2 * h / 3)):
+        ps = rec.points(u, els, NODE_XI[loc, 0], NODE_XI[loc, 1], np.full(4, zz), np.full(4, k))
+        t = ps.S[:, :, 2]
+        f = ex.fields(a / 8, a / 8, zz)
+        peak = abs(ex.fields(0.0, a / 2, zz)["txz"])
+        assert np.abs(t - [f["txz"], f["tyz"], f["szz"]]).max() < 0.02 * peak
+    z = np.array([h / 3, h / 3, 2 * h / 3, 2 * h / 3])
+    lay = np.array([0, 1, 1, 2])
+    el, xi, eta = _at(m, [a / 2, 0, 0], 4)
+    r = rec.points(u, el, xi, eta, z, lay).S[:, :, 2]
+    assert np.allclose(r[0], r[1], rtol=1e-10, atol=1e-12) and np.allclose(r[2], r[3], rtol=1e-10, atol=1e-12)
+    raw = evaluate_points(m, pb.dm, u, el, xi, eta, z, lay).S[:, 1, 2]
+    ref = ex.fields(a / 2, 0, z)["tyz"]
+    assert np.abs(raw / ref - 1).max() > 2 * np.abs(r[:, 1] / ref - 1).max()
+    el, xi, eta = _at(m, [a / 4, a / 3, 0], 2)
+    faces = rec.points(u, el, xi, eta, np.array([0.0, h]), np.array([0, 2])).S[:, :, 2]
+    assert np.abs(faces[:, :2]).max() < 1e-12
+    assert abs(faces[0, 2]) < 1e-12 and np.isclose(faces[1, 2], -np.sin(np.pi / 4) * np.sin(np.pi / 3), rtol=1e-12)
