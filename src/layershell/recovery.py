@@ -299,7 +299,13 @@ class Recovery:
     # -- point values -------------------------------------------------------------------
     def transverse(self, u, elements, xi, eta, thetaL, layers, load_factor: float = 1.0, close_top: bool = True):
         """Recovered traction vector σ·A_3 (p, 3) in Cartesian components at points given by the
-        layer coordinate Θ_L³ of ``layers``, and the frame (t1, t2, n) each (p, 3)."""
+        layer coordinate Θ_L³ of ``layers``, and the frame (t1, t2, n) each (p, 3).
+
+        Shear: ∂σ_α3/∂z = -D_α (flat form, curvature terms O(h/R) neglected). Normal stress: the
+        shell equilibrium ∂(μ σ33)/∂z = μ ∫_0^z ∂D_β/∂s_β - tr(B adj(I - zB) σ_in) with the
+        shifter μ = det(I - zB) and curvature B (MODEL.md §2, (2.12)), so that the hoop-stress
+        term of curved shells (∂(r σ_r)/∂r = σ_φ in a ring) is kept; integrated by 8-point Gauss
+        rules per layer segment."""
         m = self.model
         f = self.fields(u)
         elements = np.asarray(elements, np.int64)
@@ -308,62 +314,91 @@ class Recovery:
         spq = surface_points(m.mesh.nodes[conn], np.asarray(xi, float)[:, None], np.asarray(eta, float)[:, None],
                              per_element=True)
         t1, t2, n = (v[:, 0] for v in _tangent_frame(spq))
+        T = np.stack([t1, t2], -1)  # (p, 3, 2)
         gradN = _surface_gradients(spq)[:, 0]  # (p, 9, 3)
-        tau = np.zeros((p, 2))  # ∫ D_α
-        s33 = np.zeros(p)  # ∫ (z - ζ) E
-        tau_top = np.zeros((p, 2))
-        s33_top = np.zeros(p)
-        z_at = np.zeros(p)
-        htot = np.zeros(p)
-        zbot = np.zeros(p)
-        intE = np.zeros(p)  # ∫ E over the layers below the point (for the (z - ζ) moment)
-        momE = np.zeros(p)  # ∫ (ζ - 0) E over them
-        intE_all, momE_all = np.zeros(p), np.zeros(p)
+        A = spq.A[:, 0]
+        Aup = np.einsum("pia,pab->pib", A, np.linalg.inv(np.einsum("pia,pib->pab", A, A)))
+        Bc = np.einsum("pil,pla,pja->pij", A, spq.Bmix[:, 0], Aup)  # B^λ_α A_λ ⊗ A^α
+        Bt = np.einsum("pia,pij,pjb->pab", T, Bc, T)
+        Bt = 0.5 * (Bt + np.swapaxes(Bt, 1, 2))
         stacks = m.element_stack[elements]
         layers = np.asarray(layers, np.int64)
         thetaL = np.asarray(thetaL, float)
+        xg, wg = gauss_1d(8)
+        tau = np.zeros((p, 2))  # ∫_0^z D_α at the point
+        tau_top = np.zeros((p, 2))
+        G_int = np.zeros(p)  # ∫_0^z G
+        G_top = np.zeros(p)
+        z_at, htot = np.zeros(p), np.zeros(p)
+        I2 = np.eye(2)
         for si in np.unique(stacks):
-            sel_s = np.flatnonzero(stacks == si)
-            z0 = np.zeros(sel_s.size)
+            sel = np.flatnonzero(stacks == si)
+            ps_ = sel.size
+            z0 = np.zeros(ps_)
+            D_below = np.zeros((ps_, 2))
+            F_below = np.zeros(ps_)
+            Gacc = np.zeros(ps_)
+            Bs = Bt[sel]
             for k in m.stacks[si]:
                 ly = m.layers[k]
                 zl = levels(ly.directors)
-                H = np.einsum("pn,pn->p", spq.N[sel_s, 0], ly.thickness[conn[sel_s]])
-                Sk = _sym(f.S[k][conn[sel_s]])  # (p, 9, nl, 3, 3)
-                dS = np.einsum("pai,paljk->pljki", gradN[sel_s], Sk)[:, None]
-                Dv = self._divergence(dS, t1[sel_s, None], t2[sel_s, None], n[sel_s, None])[:, 0]  # (p, nl, 3)
-                Da = np.stack([np.einsum("pli,pi->pl", Dv, t[sel_s]) for t in (t1, t2)], -1)  # (p, nl, 2)
-                Ev = np.einsum("pai,pali->pl", gradN[sel_s], f.D[k][conn[sel_s]])  # ∂D_β/∂s_β (p, nl)
-                w1, w2 = _lagrange_integrals(zl, np.ones(1))
-                full_D = H[:, None] * np.einsum("l,pla->pa", w1[0], Da)
-                full_E = H * (Ev @ w1[0])
-                mom1 = _lagrange_integrals(zl, np.ones(1))[0][0] - w2[0]  # ∫ ζ ℓ_l = ∫ℓ - ∫(1-ζ)ℓ
-                full_M = z0 * full_E + H**2 * (Ev @ mom1)  # ∫ ζ E dζ over the layer (ζ from the bottom face)
-                here = sel_s[layers[sel_s] == k]
-                hl = np.flatnonzero(layers[sel_s] == k)
-                if here.size:
-                    s = thetaL[here] / H[hl]
-                    a1, a2 = _lagrange_integrals(zl, s)
-                    z = z0[hl] + thetaL[here]
-                    z_at[here] = z
-                    tau[here] = tau_top[here] + H[hl, None] * np.einsum("pl,pla->pa", a1, Da[hl])
-                    s33[here] = (z * intE_all[here] - momE_all[here]) + H[hl]**2 * np.einsum("pl,pl->p", a2, Ev[hl])
-                tau_top[sel_s] += full_D
-                intE_all[sel_s] += full_E
-                momE_all[sel_s] += full_M
+                nl = zl.size
+                H = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
+                Sk = _sym(f.S[k][conn[sel]])  # (p, 9, nl, 3, 3)
+                dS = np.einsum("pai,paljk->pljki", gradN[sel], Sk)[:, None]
+                Dv = self._divergence(dS, t1[sel, None], t2[sel, None], n[sel, None])[:, 0]  # (p, nl, 3)
+                Da = np.einsum("pli,pia->pla", Dv, T[sel])  # (p, nl, 2)
+                Ev = np.einsum("pai,pali->pl", gradN[sel], f.D[k][conn[sel]])  # ∂D_β/∂s_β (p, nl)
+                Sin = np.einsum("pia,pn,pnlij,pjb->plab", T[sel], spq.N[sel, 0], Sk, T[sel])  # (p, nl, 2, 2)
+                Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
+
+                def G_at(s):  # G = μ F - K at layer fractions s (p, q)
+                    a1 = np.einsum("pqm,ml->pql", s[..., None] ** (np.arange(nl) + 1) / (np.arange(nl) + 1), Vinv)
+                    L = np.einsum("pqm,ml->pql", s[..., None] ** np.arange(nl), Vinv)
+                    F = F_below[:, None] + H[:, None] * np.einsum("pql,pl->pq", a1, Ev)
+                    z = z0[:, None] + s * H[:, None]
+                    M = I2 - z[..., None, None] * Bs[:, None]
+                    mu = np.linalg.det(M)
+                    adj = np.trace(M, axis1=-2, axis2=-1)[..., None, None] * I2 - M
+                    S2 = np.einsum("pql,plab->pqab", L, Sin)
+                    K = np.einsum("pab,pqbc,pqca->pq", Bs, adj, S2)
+                    return mu * F - K
+
+                def integral(s_end):  # ∫ over the layer from its bottom to fraction s_end (p,)
+                    s = 0.5 * (xg + 1) * s_end[:, None]
+                    return 0.5 * s_end * H * (G_at(s) @ wg)
+
+                w1, _ = _lagrange_integrals(zl, np.ones(1))
+                hl = np.flatnonzero(layers[sel] == k)
+                if hl.size:
+                    here = sel[hl]
+                    s_q = thetaL[here] / H[hl]
+                    a1, _ = _lagrange_integrals(zl, s_q)
+                    tau[here] = D_below[hl] + H[hl, None] * np.einsum("pl,pla->pa", a1, Da[hl])
+                    s_all = np.zeros(ps_)
+                    s_all[hl] = s_q
+                    part = integral(s_all)
+                    G_int[here] = Gacc[hl] + part[hl]
+                    z_at[here] = z0[hl] + thetaL[here]
+                Gacc = Gacc + integral(np.ones(ps_))
+                D_below = D_below + H[:, None] * np.einsum("l,pla->pa", w1[0], Da)
+                F_below = F_below + H * (Ev @ w1[0])
                 z0 = z0 + H
-            htot[sel_s] = z0
-            s33_top[sel_s] = htot[sel_s] * intE_all[sel_s] - momE_all[sel_s]
+            tau_top[sel] = D_below
+            G_top[sel] = Gacc
+            htot[sel] = z0
+        mu_of = lambda z: np.linalg.det(I2 - z[:, None, None] * Bt)  # noqa: E731
         # boundary values from the applied face tractions
         tb, tt = self._face_tractions(elements, spq, load_factor)
-        tau_b = -np.stack([np.einsum("pi,pi->p", tb, t) for t in (t1, t2)], -1)
+        tau_b = -np.einsum("pi,pia->pa", tb, T)
         s33_b = -np.einsum("pi,pi->p", tb, n)
-        tau_t = np.stack([np.einsum("pi,pi->p", tt, t) for t in (t1, t2)], -1)
+        tau_t = np.einsum("pi,pia->pa", tt, T)
         s33_t = np.einsum("pi,pi->p", tt, n)
         frac = (z_at / htot) if close_top else np.zeros(p)
-        t_rec = tau_b - tau
-        t_rec += frac[:, None] * (tau_t - (tau_b - tau_top))
-        s_rec = s33_b + s33 + frac * (s33_t - (s33_b + s33_top))
+        t_rec = tau_b - tau + frac[:, None] * (tau_t - (tau_b - tau_top))
+        s_here = (s33_b + G_int) / mu_of(z_at)
+        s_top = (s33_b + G_top) / mu_of(htot)
+        s_rec = s_here + frac * (s33_t - s_top)
         vec = t_rec[:, :1] * t1 + t_rec[:, 1:] * t2 + s_rec[:, None] * n
         return vec, (t1, t2, n)
 
@@ -412,3 +447,36 @@ class Recovery:
                  + np.einsum("p,pi,pj->pij", np.einsum("pi,pi->p", vec, n), n, n))
         sig = cauchy_stress(ps.F, S_rec)
         return replace(ps, S=S_rec, sigma=sig)
+
+
+# ----------------------------------------------------------------------------- shared access
+_INSTANCES: list = []  # [(weakref(model), weakref(dm), Recovery)], most recent last
+
+
+def for_model(model: Model, dm: DofMap) -> Recovery:
+    """The :class:`Recovery` of ``model`` and ``dm`` (built once, kept for the latest few)."""
+    import weakref
+
+    for mref, dref, rec in _INSTANCES:
+        if mref() is model and dref() is dm:
+            return rec
+    rec = Recovery(model, dm)
+    _INSTANCES.append((weakref.ref(model), weakref.ref(dm), rec))
+    del _INSTANCES[:-4]
+    return rec
+
+
+SAMPLINGS = ("recovered", "raw")
+FRAMES = ("material", "global")
+
+
+def stress_points(model: Model, dm: DofMap, u: np.ndarray, elements, xi, eta, theta, layers=None,
+                  local_theta: bool = False, sampling: str = "recovered", load_factor: float = 1.0) -> PointState:
+    """Points for stress output: ``sampling = "recovered"`` (transverse components from
+    :class:`Recovery`) or ``"raw"`` (all from the displacement derivatives at the point,
+    :func:`layershell.results.evaluate_points`)."""
+    if sampling == "raw":
+        return evaluate_points(model, dm, u, elements, xi, eta, theta, layers, local_theta)
+    if sampling != "recovered":
+        raise ValueError(f"sampling '{sampling}': use one of {SAMPLINGS}")
+    return for_model(model, dm).points(u, elements, xi, eta, theta, layers, local_theta, load_factor)

@@ -19,10 +19,12 @@ from .solver.newton import ConvergenceError, DebondCut, load_steps
 from .solver.problem import Problem
 
 
-def through_thickness(spec_profile, model, dm, u):
-    """Stress component along the thickness at a point: {layer name: (Θ³, values)}."""
+def through_thickness(spec_profile, model, dm, u, load_factor: float = 1.0):
+    """Stress component along the thickness at a point: {layer name: (Θ³, values)}; the profile's
+    ``sampling`` (recovered transverse stresses by default) and ``frame``."""
     from .io.probes import STRESS_COMPONENTS
-    from .results import evaluate_points, locate
+    from .recovery import stress_points
+    from .results import locate
 
     pr = spec_profile
     e, x, y, _ = locate(model, pr.point)
@@ -35,8 +37,9 @@ def through_thickness(spec_profile, model, dm, u):
         H = float(N[0] @ model.layers[k].thickness[conn])
         off = float(N[0] @ model.offset(k)[conn])
         thL = np.linspace(0.0, H, pr.points_per_layer)
-        ps = evaluate_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True)
-        T = ps.cauchy_physical if pr.measure == "cauchy" else ps.pk2_physical
+        ps = stress_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True,
+                           sampling=getattr(pr, "sampling", "recovered"), load_factor=load_factor)
+        T = ps.stress(pr.measure, getattr(pr, "frame", "material"))
         c = pr.component
         if c in STRESS_COMPONENTS:
             i, j = STRESS_COMPONENTS[c]
@@ -50,13 +53,13 @@ def through_thickness(spec_profile, model, dm, u):
     return out
 
 
-def write_profiles(spec, problem, u, out: Path) -> dict:
+def write_profiles(spec, problem, u, out: Path, load_factor: float = 1.0) -> dict:
     """profile_<name>.csv (Θ³ and one column per layer) and profile_<name>.png."""
     from .io.output import write_csv
 
     files = {}
     for pr in spec.profiles:
-        cols = through_thickness(pr, spec.model, problem.dm, u)
+        cols = through_thickness(pr, spec.model, problem.dm, u, load_factor)
         names = list(cols)
         rows = []
         for i, n in enumerate(names):
@@ -297,7 +300,8 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                     if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
                         from .export import export_step
 
-                        paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl)
+                        paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl,
+                                            spec.output.sampling, spec.output.frame)
                         pvd.add(st.step, st.load_factor, paths)
                     summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
@@ -337,7 +341,7 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
             raise pending
         summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
         if out is not None and spec.profiles and summary["steps"]:
-            summary["profiles"] = write_profiles(spec, problem, u, out)
+            summary["profiles"] = write_profiles(spec, problem, u, out, float(summary["steps"][-1]["load_factor"]))
         if out is not None:
             write_files()
             if spec.output.plots:

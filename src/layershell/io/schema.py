@@ -325,6 +325,16 @@ class ProbeDef(Strict):
         None, description="displacement: x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises; "
                           "traction: 13|23|33|shear")
     measure: Literal["cauchy", "pk2"] = "cauchy"
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="stress/traction: 'recovered' (default): transverse stresses σ13, σ23, σ33 from "
+        "the 3D equilibrium integrated through the thickness over patch-smoothed in-plane stresses (continuous "
+        "through the layers, accurate at element edges and nodes; small strains, plates and shallow shells); "
+        "'raw': every component from the displacement derivatives at the point (σ13, σ23 exact only at the "
+        "reduced Gauss points)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="stress/traction components: 'material' (default): in the layer's material "
+        "axes M_1, M_2, M_3 (in a 90° ply σ13 is τ_yz and σ23 is -τ_xz); 'global': in the global x, y, z axes "
+        "(11 = xx, 23 = yz, 13 = xz; traction 13|23|33 = the x, y, z components of σ·n)")
     theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
     layer: str | None = None
@@ -352,6 +362,11 @@ class ProfileDef(Strict):
     point: Vec3 = Field(description="point on the reference surface")
     component: str = Field("11", description="11|22|33|23|13|12|p1|p2|p3|von_mises")
     measure: Literal["cauchy", "pk2"] = "cauchy"
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="'recovered' (default) transverse stresses σ13, σ23, σ33 from the equilibrium "
+        "through the thickness, or 'raw' values from the displacement derivatives (as [[probes]] sampling)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="components in the layers' material axes (default) or the global x, y, z axes")
     points_per_layer: int = Field(21, ge=2, le=1001)
 
 
@@ -406,6 +421,13 @@ class DelaminationDef(Strict):
 
 class OutputDef(Strict):
     vtu: bool = True
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="stresses in the solid and interface ParaView files: 'recovered' (default) "
+        "transverse stresses σ13, σ23, σ33 from the equilibrium through the thickness, or 'raw' values from the "
+        "displacement derivatives (as [[probes]] sampling)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="stress components in the ParaView files: the layers' material axes (default) "
+        "or the global x, y, z axes")
     plots: bool = True
     every: PositiveInt = Field(1, description="write ParaView files every n-th step (the last is always written)")
     zone_steps: list[PositiveInt] | None = Field(
