@@ -276,24 +276,15 @@ class Recovery:
         for k in S:
             els = np.flatnonzero([k in m.stacks[s] for s in m.element_stack])
             Sk = _sym(S[k][E[els]])  # (e, 9 nodes, nl, 3, 3)
-            dS = np.einsum("eqai,ealjk->eqljki", gradN[els], Sk)  # ∂S_jk/∂X_i at the Gauss points
+            T = np.stack([t1[els], t2[els]], -1)  # (e, g, 3, 2)
+            gT = np.einsum("egni,egib->egnb", gradN[els], T)  # derivatives along t_β
+            dS = np.einsum("egnb,enlij->eglbij", gT, Sk)  # ∂S/∂s_β at the Gauss points
+            Da = np.einsum("eglbij,egjb,egia->egla", dS, T, T, optimize=True)  # t_α·∂S/∂s_β·t_β
             Dv = np.zeros((ne, ng) + S[k].shape[1:2] + (3,))
-            Dv[els] = self._divergence(dS, t1[els], t2[els], n[els])  # (e, g, nl, 3)
+            Dv[els] = np.einsum("egla,egia->egli", Da, T)  # (e, g, nl, 3) tangential vector
             D[k] = (self.R[k] @ Dv.reshape(ne * ng, -1)).reshape(m.mesh.n_nodes, -1, 3)
         out = RecoveryFields(S, D)
         self._cache = (key, out)
-        return out
-
-    @staticmethod
-    def _divergence(dS, t1, t2, n):
-        """Tangential vector Σ_αβ t_α (t_α·∂S/∂s_β·t_β) (…, nl, 3) from ``dS (…, nl, 3, 3, 3)``
-        = ∂S_jk/∂X_i (indices l, j, k, i) and frames (…, 3)."""
-        out = 0.0
-        for ta in (t1, t2):
-            Da = 0.0
-            for tb in (t1, t2):
-                Da = Da + np.einsum("eqljki,eqj,eqk,eqi->eql", dS, ta, tb, tb)
-            out = out + Da[..., None] * ta[:, :, None, :]
         return out
 
     # -- point values -------------------------------------------------------------------
@@ -345,11 +336,11 @@ class Recovery:
                 nl = zl.size
                 H = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
                 Sk = _sym(f.S[k][conn[sel]])  # (p, 9, nl, 3, 3)
-                dS = np.einsum("pai,paljk->pljki", gradN[sel], Sk)[:, None]
-                Dv = self._divergence(dS, t1[sel, None], t2[sel, None], n[sel, None])[:, 0]  # (p, nl, 3)
-                Da = np.einsum("pli,pia->pla", Dv, T[sel])  # (p, nl, 2)
+                Skt = np.einsum("pia,pnlij,pjb->pnlab", T[sel], Sk, T[sel], optimize=True)  # tangent frame
+                gT = np.einsum("pni,pib->pnb", gradN[sel], T[sel])
+                Da = np.einsum("pnb,pnlab->pla", gT, Skt)  # D_α = ∂σ_αβ/∂s_β (p, nl, 2)
                 Ev = np.einsum("pai,pali->pl", gradN[sel], f.D[k][conn[sel]])  # ∂D_β/∂s_β (p, nl)
-                Sin = np.einsum("pia,pn,pnlij,pjb->plab", T[sel], spq.N[sel, 0], Sk, T[sel])  # (p, nl, 2, 2)
+                Sin = np.einsum("pn,pnlab->plab", spq.N[sel, 0], Skt)  # (p, nl, 2, 2)
                 Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
 
                 def G_at(s):  # G = μ F - K at layer fractions s (p, q)
