@@ -68,6 +68,32 @@ def test_patch_recovery_reproduces_complete_polynomials(patch, degree):
     assert np.abs(R @ f(X) - f(mesh.nodes)).max() < 1e-11
 
 
+def test_patch_recovery_at_symmetry_planes_mirrors_the_field():
+    """Nodes on symmetry planes (x = 2 and y = 0 here) fit their patch completed by its mirror
+    images: a field even about both planes and one odd about x = 2 (even about y = 0) are
+    recovered exactly at every node, including the corner on both planes."""
+    from layershell.recovery import Recovery
+
+    mesh = rectangle(2.0, 1.0, 8, 6)
+    x = mesh.nodes
+    sym = [Symmetry(np.flatnonzero(np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0])),
+           Symmetry(np.flatnonzero(np.isclose(x[:, 1], 0.0)), np.array([0, -1.0, 0]))]
+    m = Model(mesh, [Layer("a", PLY, 1, np.full(mesh.n_nodes, 0.1))], [(0,)], np.zeros(mesh.n_elements, int),
+              symmetries=sym)
+    rec = Recovery.__new__(Recovery)
+    Recovery.__init__(rec, m, None)
+    assert set(rec.R[0]) == {0, 1, 2, 3}
+    pts, _ = gauss_2d(3)
+    X = surface_points(mesh.nodes[mesh.elements], pts[:, 0], pts[:, 1]).X0.reshape(-1, 3)
+    even = lambda X: 1 + 0.5 * (X[:, 0] - 2) ** 2 - 0.3 * X[:, 1] ** 2 + 0.2  # noqa: E731
+    odd = lambda X: 1.5 * (X[:, 0] - 2)  # noqa: E731  (the quadratic odd in x - 2, even in y)
+    # components (0, 0): even under both reflections; (0, 2): odd under the x-reflection only
+    samples = np.stack([even(X), odd(X)], -1)[:, None, :]
+    got = rec._apply(0, samples, ((0, 0), (0, 2)))[:, 0]
+    assert np.abs(got[:, 0] - even(mesh.nodes)).max() < 1e-11
+    assert np.abs(got[:, 1] - odd(mesh.nodes)).max() < 1e-11
+
+
 def _thin(s):
     """a/h ≥ 20: the fully integrated element's in-plane stresses carry a locking oscillation
     (linear within each element, ±13 on σ_yy ≈ 256 at a/h = 100) whose slope the recovery
@@ -83,7 +109,8 @@ def test_cross_ply_plate_against_exact_3d_solution(s):
     """[0/90/0], a/h = s, 8 × 8 quarter mesh, d = 3: mid-plane deflection within 0.5 %,
     σxx (centre, top) and σyy (centre, top of the 90° ply) within 1 %, and the recovered τxz at
     the edge x = 0 and τyz at the edge y = 0 within 2 % of the exact values at the two ply
-    interfaces (from both plies) and at mid-thickness; recovered σzz within 2 % of q0 at (a/4, a/4)."""
+    interfaces (from both plies) and at mid-thickness; recovered σzz within 2 % of q0 at (a/4, a/4) and
+    within 3 % at the centre (on both symmetry planes)."""
     h, q0 = 1.0, 1.0
     a = s * h
     m, pb, u, ex = cross_ply_plate(s, h=h, q0=q0)
@@ -106,6 +133,9 @@ def test_cross_ply_plate_against_exact_3d_solution(s):
     el, xi, eta = _at(m, [a / 4, a / 4, 0], z.size)  # away from the symmetry planes (see Recovery)
     s33 = rec.points(u, el, xi, eta, z, lay).S[:, 2, 2]
     assert np.abs(s33 - ex.fields(a / 4, a / 4, z)["szz"]).max() < 0.02 * q0
+    el, xi, eta = _at(m, [a / 2, a / 2, 0], z.size)  # the corner of two symmetry planes
+    s33 = rec.points(u, el, xi, eta, z, lay).S[:, 2, 2]
+    assert np.abs(s33 - ex.fields(a / 2, a / 2, z)["szz"]).max() < 0.03 * q0
 
 
 def test_recovered_stresses_continuous_and_raw_ones_oscillate():
