@@ -196,11 +196,15 @@ def _cantilever_90(extra: str = ""):
 def test_global_frame_in_a_90_degree_ply(sampling):
     """In a 90° layer the material σ13 is τ_yz (≈ 0 here) and σ23 = ±τ_xz; frame = "global"
     gives τ_xz directly: |τ_xz| = 150 (beam theory, ν = 0) at the interface, between Gauss
-    points (x = 5.5: the raw value is 14 % off there, the recovered one within 1 %)."""
+    points (x = 5.5: the raw value of the fully integrated element is 14 % off there, the
+    recovered one within 1 %)."""
     res = _cantilever_90(f'sampling = "{sampling}"')
     p = res.summary["probes"]
     err = abs(abs(p["s13_global"]) / 150.0 - 1)
-    assert err < 0.01 if sampling == "recovered" else err > 0.1
+    if sampling == "recovered":
+        assert err < 0.01
+    elif getattr(res.problem.model, "element", "full") == "full":
+        assert err > 0.1
     assert abs(p["s23_global"]) < 1e-6 * 150 and abs(p["s13_material"]) < 1e-6 * 150
     assert np.isclose(abs(p["s23_material"]), abs(p["s13_global"]), rtol=1e-12)
     # the 90° layer's material axes (rows M_1, M_2, M_3): M_1 ∥ ±y, M_2 ∥ ±x, so σ23 = (M_2·x)(M_3·z) τ_xz
@@ -215,8 +219,8 @@ def test_vtu_stresses_recovered_and_global():
     """Solid and interface ParaView data of the two-layer cantilever: with the defaults the
     interface σ23 of the 90° layer (material axes) and with frame = "global" the σ13 (= τ_xz) are
     ±150 within 1 % at every interface node with 3 ≤ x ≤ 7 (the elements at the clamp and at the
-    loaded end carry their 3D disturbances); raw values
-    there scatter by more than 10 %."""
+    loaded end carry their 3D disturbances); raw values of the fully
+    integrated element scatter there by more than 10 %."""
     from layershell.export import interface_mesh, solid_mesh
     from layershell.interfaces import interfaces
 
@@ -236,7 +240,8 @@ def test_vtu_stresses_recovered_and_global():
     assert np.allclose(np.abs(mat["sigma23"][inner]), 150.0, rtol=0.01)
     assert np.allclose(np.abs(glo["sigma13"][inner]), 150.0, rtol=0.01)
     assert np.allclose(glo["shear"], mat["shear"]) and np.abs(glo["sigma23"]).max() < 1e-6
-    assert np.abs(np.abs(raw["sigma13"][inner]) / 150.0 - 1).max() > 0.1
+    if getattr(m, "element", "full") == "full":  # the fully integrated element's raw shear oscillates
+        assert np.abs(np.abs(raw["sigma13"][inner]) / 150.0 - 1).max() > 0.1
     sol = solid_mesh(m, dm, u, frame="global")
     X = sol.points
     mid = (np.abs(X[:, 2] + 0.5) < 1e-9) & (X[:, 0] > 3.0 - 1e-9) & (X[:, 0] < 7.0 + 1e-9)
