@@ -14,19 +14,23 @@ Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recov
    components at each level.
 2. At a point: in-plane divergence D_α = ∂σ_αβ/∂s_β from the derivatives of the shape
    functions (s_β: arc length along the orthonormal tangent frame t_1 = A_1/|A_1|, t_2 = A_3 × t_1).
-3. ∂σ_α3/∂Θ³ = -D_α and ∂σ_33/∂Θ³ = -∂σ_β3/∂s_β are integrated exactly (the levels carry the
-   degree-d_L polynomial of each layer) from the bottom face, where σ·(-A_3) equals the
-   applied traction; ∂D_β/∂s_β comes from D at the Gauss points recovered to the nodes in
-   turn (a second pass of the same patch operator).
+3. ∂σ_α3/∂Θ³ = -D_α is integrated exactly (the levels carry the degree-d_L polynomial of each
+   layer) from the bottom face, where σ·(-A_3) equals the applied traction. σ33 follows from
+   the shell equilibrium ∂(μ σ33)/∂Θ³ = μ ∫ ∂D_β/∂s_β - tr(B adj(I - Θ³B) σ_in) (shifter μ,
+   curvature B: the hoop term of curved shells), by Gauss rules per layer; ∂D_β/∂s_β comes from
+   D at the Gauss points recovered to the nodes in turn (a second pass of the patch operator,
+   with mirror images at symmetry planes, :func:`mirrored_operators`).
 4. The misfit against the applied traction on the top face is spread linearly over the
    thickness (it vanishes for an exactly equilibrated field; it is the usual closure of
    through-thickness integration).
 
 Assumptions (documented in docs/user-guide.md): small strains (PK2 in the undeformed frame),
-curvature terms of the shell equilibrium neglected (error O(h/R)), applied tractions on the
+curvature terms of the shear equations neglected (error O(h/R)), applied tractions on the
 'reference' and 'top' faces only (volume loads, loads on interior faces and the divergence of
-tangential face loads are not included). The linear stress tensor returned replaces the
-transverse components (σ_i3 in the frame t_1, t_2, A_3) of the raw one; in-plane components stay raw.
+tangential face loads are not included), the stack bonded through the thickness. The stress
+tensor returned replaces the transverse components (σ_i3 in the frame t_1, t_2, A_3) of the raw
+one; in-plane components stay raw. Validation: tests/test_recovery.py (exact 3D solution of a
+[0/90/0] plate, layershell.analytic.pagano) and tests/test_layers.py (Girkmann's curved beam).
 """
 from __future__ import annotations
 
