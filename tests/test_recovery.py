@@ -246,3 +246,34 @@ def test_vtu_stresses_recovered_and_global():
     X = sol.points
     mid = (np.abs(X[:, 2] + 0.5) < 1e-9) & (X[:, 0] > 3.0 - 1e-9) & (X[:, 0] < 7.0 + 1e-9)
     assert mid.sum() > 0 and np.allclose(np.abs(sol.point_data["cauchy"][mid, 4]), 150.0, rtol=0.01)
+
+
+def test_delamination_criterion_can_use_recovered_tractions():
+    """[delamination] stresses = "recovered": the failure criterion sees the recovered interface
+    tractions. Two-layer cantilever (ν = 0, bonded solution linear in λ): with τ_max between the
+    largest recovered and the largest raw shear at the face Gauss points, one load step debonds
+    with the tractions of the larger kind and not with the other (raw: 3 × 3 face Gauss points
+    of the fully integrated element, off between the reduced points)."""
+    from layershell.interfaces import interface_state, interfaces
+
+    res = _cantilever_90()
+    m, dm, u = res.problem.model, res.problem.dm, res.u
+    itf = interfaces(m)[0]
+    shear = {s: np.hypot(*interface_state(m, dm, u, itf, "gauss", s).traction()[:, :2].T).max()
+             for s in ("raw", "recovered")}
+    assert abs(shear["raw"] - shear["recovered"]) > 0.02 * shear["recovered"]
+    tau_max = 0.5 * (shear["raw"] + shear["recovered"])
+    from helpers import run_example
+
+    first = {}
+    for s in ("raw", "recovered"):
+        text = {"nu = 0.4": "nu = 0.0",
+                '[[layers]]\nname = "beam"\nmaterial = "mat"\nthickness = 1.0\ndirectors = 3':
+                    '[[layers]]\nname = "top"\nmaterial = "mat"\nthickness = 0.5\ndirectors = 3\n\n'
+                    '[[layers]]\nname = "bottom"\nmaterial = "mat"\nthickness = 0.5\ndirectors = 3\nangle = 90.0\n\n'
+                    f'[[interfaces]]\nlayer = "bottom"\nsigma_max = 1e9\ntau_max = {tau_max}\n\n'
+                    f'[delamination]\nstresses = "{s}"'}
+        first[s] = run_example("cantilever_thick", text).summary["first_delamination_load_factor"]
+    larger = max(shear, key=shear.get)
+    smaller = min(shear, key=shear.get)
+    assert first[larger] == 1.0 and first[smaller] is None

@@ -403,6 +403,11 @@ class InterfaceDef(Strict):
 
 
 class DelaminationDef(Strict):
+    stresses: Literal["raw", "recovered"] = Field(
+        "raw", description="interface tractions the failure criterion (4.15) sees: 'raw' (default, the thesis): "
+        "from the displacement derivatives at the face Gauss points; 'recovered': σ13, σ23, σ33 from the 3D "
+        "equilibrium through the thickness, as in the outputs (less mesh-dependent onset; the recovery treats "
+        "the stack as bonded)")
     friction: Literal["return_mapping", "explicit"] = Field(
         "return_mapping", description="friction as a penalty return mapping (implicit), or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
