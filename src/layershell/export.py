@@ -135,11 +135,13 @@ def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
     )
 
 
-def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
-    """meshio.Mesh of the extruded shell: per element and layer a 3×3×3 lattice, 8 hexahedra."""
+def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray, sampling: str = "recovered", frame: str = "material",
+               load_factor: float = 1.0):
+    """meshio.Mesh of the extruded shell: per element and layer a 3×3×3 lattice, 8 hexahedra;
+    stresses with recovered (or raw) transverse components, in material (or global) axes."""
     import meshio
 
-    from .results import evaluate_points
+    from .recovery import stress_points
 
     mesh = model.mesh
     element_stack = np.asarray(model.element_stack)
@@ -158,12 +160,13 @@ def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
         xi = np.broadcast_to(NODE_XI[_LAT_NODE, 0], (ne, 27))
         eta = np.broadcast_to(NODE_XI[_LAT_NODE, 1], (ne, 27))
         e_pts = np.repeat(elems, 27)
-        ps = evaluate_points(model, dm, u_full, e_pts, xi.ravel(), eta.ravel(), thL.ravel(), layers=k, local_theta=True)
-        cau = ps.cauchy_physical
+        ps = stress_points(model, dm, u_full, e_pts, xi.ravel(), eta.ravel(), thL.ravel(), layers=k, local_theta=True,
+                           sampling=sampling, load_factor=load_factor)
+        cau = ps.stress("cauchy", frame)
         pts.append(ps.X)
         data["displacement"].append(ps.u)
         data["cauchy"].append(stress_components(cau))
-        data["pk2"].append(stress_components(ps.pk2_physical))
+        data["pk2"].append(stress_components(ps.stress("pk2", frame)))
         data["von_mises"].append(von_mises(cau))
         data["principal"].append(np.linalg.eigvalsh(cau)[:, ::-1])
         base = n_pts + 27 * np.arange(ne)
@@ -194,19 +197,20 @@ def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
 
 
 def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.ndarray,
-                load_factor: float, controller=None) -> dict[str, Path]:
+                load_factor: float, controller=None, sampling: str = "recovered",
+                frame: str = "material") -> dict[str, Path]:
     """Write ``surface_{step:04d}.vtu`` and ``solid_{step:04d}.vtu`` into ``out_dir``.
 
     Returns ``{"surface": path, "solid": path}``. ``load_factor`` is not stored in the files
     (meshio's VTU writer drops field data); it is the time value of the ``.pvd`` collections
-    (:class:`PvdWriter`).
+    (:class:`PvdWriter`) and scales the face tractions of the stress recovery. ``sampling`` and
+    ``frame``: [output] sampling/frame of the solid and interface stresses.
     """
-    del load_factor  # kept in the signature for the caller's bookkeeping / future metadata
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     u_full = np.asarray(u_full, float)
     surf = surface_mesh(model, dm, u_full)
-    solid = solid_mesh(model, dm, u_full)
+    solid = solid_mesh(model, dm, u_full, sampling, frame, load_factor)
     paths = {"surface": out_dir / f"surface_{step:04d}.vtu", "solid": out_dir / f"solid_{step:04d}.vtu"}
     _write_vtu(paths["surface"], surf)
     _write_vtu(paths["solid"], solid)
@@ -219,23 +223,30 @@ def export_step(out_dir: Path, step: int, model: Model, dm: DofMap, u_full: np.n
             run = None
             if controller is not None:
                 run = next((r for r in controller.runs if r.block.itf.upper == itf.upper), None)
-            _write_vtu(paths[key], interface_mesh(model, dm, u_full, itf, run))
+            _write_vtu(paths[key], interface_mesh(model, dm, u_full, itf, run, sampling, frame, load_factor))
     return paths
 
 
-def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None):
+def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None, sampling: str = "recovered",
+                   frame: str = "material", load_factor: float = 1.0):
     """meshio.Mesh of one interface (quad9 per element, nodes duplicated per element) with the
-    traction components σ13, σ23, σ33 of the upper layer (3.33), the shear resultant and the
-    displacement of the interface."""
+    traction components σ13, σ23, σ33 of the upper layer (3.33) (recovered or raw, material axes
+    or global x, y, z), the shear resultant and the displacement of the interface."""
     import meshio
 
-    from .interfaces import interface_state
+    from .interfaces import face_points
+    from .recovery import stress_points
 
-    ps = interface_state(model, dm, u_full, itf, kind="nodes")
-    t = ps.traction()
+    xi, eta = face_points("nodes")
+    ne_ = itf.elements.size
+    ps = stress_points(model, dm, u_full, np.repeat(itf.elements, 9), np.tile(xi, ne_), np.tile(eta, ne_),
+                       np.zeros(9 * ne_), np.full(9 * ne_, itf.upper), local_theta=True, sampling=sampling,
+                       load_factor=load_factor)
+    t = ps.traction(frame)
+    tm = ps.traction()
     ne = itf.elements.size
     point_data = {"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
-                  "shear": np.hypot(t[:, 0], t[:, 1]), "displacement": ps.u}
+                  "shear": np.hypot(tm[:, 0], tm[:, 1]), "displacement": ps.u}
     if run is not None:
         # delamination state lives at the 9 face Gauss points; each belongs to exactly one node
         # region (MODEL.md §9 rule 1), so it maps one-to-one onto the element's nodes

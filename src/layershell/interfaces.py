@@ -43,13 +43,20 @@ def face_points(kind: str = "gauss") -> tuple[np.ndarray, np.ndarray]:
     return NODE_XI[:, 0], NODE_XI[:, 1]
 
 
-def interface_state(model: Model, dm: DofMap, u: np.ndarray, itf: Interface, kind: str = "gauss") -> PointState:
+def interface_state(model: Model, dm: DofMap, u: np.ndarray, itf: Interface, kind: str = "gauss",
+                    sampling: str = "raw", load_factor: float = 1.0) -> PointState:
     """PointState of the upper layer at Θ_L³ = 0 for every element of the interface × 9 points
-    (point index = element-major)."""
+    (point index = element-major); ``sampling = "recovered"``: transverse stresses from
+    :mod:`layershell.recovery` (the applied face loads scaled by ``load_factor``)."""
     xi, eta = face_points(kind)
     ne = itf.elements.size
-    return evaluate_points(model, dm, u, np.repeat(itf.elements, 9), np.tile(xi, ne), np.tile(eta, ne),
-                           np.zeros(9 * ne), np.full(9 * ne, itf.upper), local_theta=True)
+    args = (model, dm, u, np.repeat(itf.elements, 9), np.tile(xi, ne), np.tile(eta, ne), np.zeros(9 * ne),
+            np.full(9 * ne, itf.upper))
+    if sampling != "raw":
+        from .recovery import stress_points
+
+        return stress_points(*args, local_theta=True, sampling=sampling, load_factor=load_factor)
+    return evaluate_points(*args, local_theta=True)
 
 
 def traction_summary(model: Model, dm: DofMap, u: np.ndarray) -> dict[str, dict[str, float]]:

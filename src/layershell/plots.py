@@ -350,8 +350,9 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
 
         if through_thickness is None:  # the sampler is handed in (runner.through_thickness): no import circle
             continue
-        prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21)
-        cols = through_thickness(prof, model, problem.dm, u)
+        prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21,
+                               sampling=pd.sampling, frame=pd.frame)
+        cols = through_thickness(prof, model, problem.dm, u, lam[-1])
         f = f"thickness_{_safe(pd.name)}.png"
         mark = None
         if isinstance(pd.theta3, (int, float)) and pd.reduce == "none" and pd.scale:

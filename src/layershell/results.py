@@ -47,13 +47,23 @@ class PointState:
         """σ_m^kl = m_k · σ · m_l (2.107)."""
         return np.einsum("pki,pij,plj->pkl", self.m, self.sigma, self.m)
 
+    def stress(self, measure: str = "cauchy", frame: str = "material") -> np.ndarray:
+        """Stress tensors (p, 3, 3): Cauchy or PK2, in the material frame (physical components
+        (2.106)/(2.107); in a 90° ply σ13 is τ_yz) or in global Cartesian axes x, y, z."""
+        if frame == "global":
+            return self.sigma if measure == "cauchy" else self.S
+        return self.cauchy_physical if measure == "cauchy" else self.pk2_physical
+
     def principal(self, measure: str = "cauchy") -> np.ndarray:
         """Principal stresses, descending (p, 3)."""
         t = self.cauchy_physical if measure == "cauchy" else self.pk2_physical
         return np.linalg.eigvalsh(t)[:, ::-1]
 
-    def traction(self) -> np.ndarray:
-        """Surface traction components σ_m^{k3} (2.114): [σ13, σ23, σ33] per point."""
+    def traction(self, frame: str = "material") -> np.ndarray:
+        """Surface traction σ·m_3 per point: components σ_m^{k3} (2.114) [σ13, σ23, σ33] in the
+        material frame, or its global x, y, z components (``frame = "global"``)."""
+        if frame == "global":
+            return np.einsum("pij,pj->pi", self.sigma, self.m[:, 2])
         return self.cauchy_physical[:, :, 2]
 
 

@@ -19,10 +19,12 @@ from .solver.newton import ConvergenceError, DebondCut, load_steps
 from .solver.problem import Problem
 
 
-def through_thickness(spec_profile, model, dm, u):
-    """Stress component along the thickness at a point: {layer name: (Θ³, values)}."""
+def through_thickness(spec_profile, model, dm, u, load_factor: float = 1.0):
+    """Stress component along the thickness at a point: {layer name: (Θ³, values)}; the profile's
+    ``sampling`` (recovered transverse stresses by default) and ``frame``."""
     from .io.probes import STRESS_COMPONENTS
-    from .results import evaluate_points, locate
+    from .recovery import stress_points
+    from .results import locate
 
     pr = spec_profile
     e, x, y, _ = locate(model, pr.point)
@@ -35,8 +37,9 @@ def through_thickness(spec_profile, model, dm, u):
         H = float(N[0] @ model.layers[k].thickness[conn])
         off = float(N[0] @ model.offset(k)[conn])
         thL = np.linspace(0.0, H, pr.points_per_layer)
-        ps = evaluate_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True)
-        T = ps.cauchy_physical if pr.measure == "cauchy" else ps.pk2_physical
+        ps = stress_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True,
+                           sampling=getattr(pr, "sampling", "recovered"), load_factor=load_factor)
+        T = ps.stress(pr.measure, getattr(pr, "frame", "material"))
         c = pr.component
         if c in STRESS_COMPONENTS:
             i, j = STRESS_COMPONENTS[c]
@@ -50,11 +53,11 @@ def through_thickness(spec_profile, model, dm, u):
     return out
 
 
-def write_profiles(spec, problem, u, rec: Recorder) -> dict:
+def write_profiles(spec, problem, u, rec: Recorder, load_factor: float = 1.0) -> dict:
     """profile_<name>.csv (Θ³ and one column per layer) and profile_<name>.png."""
     files = {}
     for pr in spec.profiles:
-        cols = through_thickness(pr, spec.model, problem.dm, u)
+        cols = through_thickness(pr, spec.model, problem.dm, u, load_factor)
         names = list(cols)
         rows = []
         for i, n in enumerate(names):
@@ -390,7 +393,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
                         from .export import export_step
 
-                        paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl)
+                        paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl,
+                                            spec.output.sampling, spec.output.frame)
                         rcd.register(paths.values())
                         rcd.register([f"{k}.pvd" for k in paths])
                         pvd.add(st.step, st.load_factor, paths)
@@ -446,7 +450,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                 rcd.summary(summary, force=True)
             raise pending
         if rcd is not None and spec.profiles and summary["steps"]:
-            summary["profiles"] = write_profiles(spec, problem, u, rcd)
+            summary["profiles"] = write_profiles(spec, problem, u, rcd, float(summary["steps"][-1]["load_factor"]))
         if rcd is not None:
             rcd.summary(summary, force=True)
             if spec.output.plots:

@@ -638,7 +638,8 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
         raise InputError("'delamination.max_debond_fraction' measures the debonding of the re-solutions at one "
                          "load level; with 'delamination.reequilibrate = false' there are none: remove one of them")
     model.delamination = DelaminationSettings(d.max_release, d.max_resolves, d.friction,
-                                             d.max_debond_fraction, d.max_debond_cuts, d.reequilibrate)
+                                             d.max_debond_fraction, d.max_debond_cuts, d.reequilibrate,
+                                             stresses=d.stresses)
 
 
 def _zero_load(ld) -> bool:

@@ -37,21 +37,32 @@ class Probe:
     about: float | None = None  # resultant: Θ³ of the moment axis (None: mid-height of the stack)
     unit: str | None = None  # label of the value on plot axes
     _cache: dict | None = None
+    sampling: str = "recovered"  # stress/traction: "recovered" transverse stresses or "raw" (recovery.py)
+    frame: str = "material"  # stress/traction components in the material frame or "global" x, y, z
 
-    def points(self, model, dm, u) -> PointState:
+    def points(self, model, dm, u, load_factor: float = 1.0) -> PointState:
         layers = None if self.layer is None else np.full(self.elements.size, self.layer)
-        return evaluate_points(model, dm, u, self.elements, self.xi, self.eta, self.theta, layers, self.local_theta)
+        if self.quantity == "displacement":
+            return evaluate_points(model, dm, u, self.elements, self.xi, self.eta, self.theta, layers, self.local_theta)
+        from ..recovery import stress_points
 
-    def samples(self, model, dm, u) -> np.ndarray:
-        ps = self.points(model, dm, u)
+        return stress_points(model, dm, u, self.elements, self.xi, self.eta, self.theta, layers, self.local_theta,
+                             self.sampling, load_factor)
+
+    def samples(self, model, dm, u, load_factor: float = 1.0) -> np.ndarray:
+        ps = self.points(model, dm, u, load_factor)
         c = self.component
         if self.quantity == "displacement":
             vals = np.linalg.norm(ps.u, axis=1) if c == "magnitude" else ps.u[:, "xyz".index(c)]
         elif self.quantity == "traction":
-            t = ps.traction()
-            vals = np.hypot(t[:, 0], t[:, 1]) if c == "shear" else t[:, {"13": 0, "23": 1, "33": 2}[c]]
+            t = ps.traction(self.frame)
+            if c == "shear":  # the tangential part (frame-independent)
+                tm = ps.traction()
+                vals = np.hypot(tm[:, 0], tm[:, 1])
+            else:
+                vals = t[:, {"13": 0, "23": 1, "33": 2}[c]]
         else:
-            T = ps.cauchy_physical if self.measure == "cauchy" else ps.pk2_physical
+            T = ps.stress(self.measure, self.frame)
             if c in STRESS_COMPONENTS:
                 i, j = STRESS_COMPONENTS[c]
                 vals = T[:, i, j]
@@ -168,7 +179,7 @@ class Probe:
             return self.scale * float(load_factor)
         if self.quantity == "debonded_area":
             return self.scale * self.debonded_area(interfaces)
-        v = self.samples(model, dm, u)
+        v = self.samples(model, dm, u, load_factor)
         if self.reduce == "max":
             return float(v.max())
         if self.reduce == "min":
@@ -283,7 +294,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         eta_all = np.repeat(eta, th.size)
         th_all = np.tile(th, P)
         out.append(Probe(pd.name, pd.quantity, comp, pd.measure, el_all, xi_all, eta_all, th_all, k, local,
-                         pd.reduce, pd.scale, unit=pd.unit))
+                         pd.reduce, pd.scale, unit=pd.unit, sampling=pd.sampling, frame=pd.frame))
     return out
 
 

@@ -399,6 +399,16 @@ class ProbeDef(Strict):
                           "traction: 13|23|33|shear")
     measure: Literal["cauchy", "pk2"] = Field("cauchy", description=(
         "stress measure: Cauchy (true) or second Piola-Kirchhoff"))
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="stress/traction: 'recovered' (default): transverse stresses σ13, σ23, σ33 from "
+        "the 3D equilibrium integrated through the thickness over patch-smoothed in-plane stresses (continuous "
+        "through the layers, accurate at element edges and nodes; small strains, plates and shallow shells); "
+        "'raw': every component from the displacement derivatives at the point (σ13, σ23 exact only at the "
+        "reduced Gauss points)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="stress/traction components: 'material' (default): in the layer's material "
+        "axes M_1, M_2, M_3 (in a 90° ply σ13 is τ_yz and σ23 is -τ_xz); 'global': in the global x, y, z axes "
+        "(11 = xx, 23 = yz, 13 = xz; traction 13|23|33 = the x, y, z components of σ·n)")
     theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
     layer: str | None = Field(None, description=(
@@ -450,6 +460,11 @@ class ProfileDef(Strict):
     component: str = Field("11", description="11|22|33|23|13|12|p1|p2|p3|von_mises")
     measure: Literal["cauchy", "pk2"] = Field("cauchy", description=(
         "stress measure: Cauchy (true) or second Piola-Kirchhoff"))
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="'recovered' (default) transverse stresses σ13, σ23, σ33 from the equilibrium "
+        "through the thickness, or 'raw' values from the displacement derivatives (as [[probes]] sampling)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="components in the layers' material axes (default) or the global x, y, z axes")
     points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer")
 
 
@@ -491,6 +506,11 @@ class InterfaceDef(Strict):
 
 
 class DelaminationDef(Strict):
+    stresses: Literal["raw", "recovered"] = Field(
+        "raw", description="interface tractions the failure criterion (4.15) sees: 'raw' (default, the thesis): "
+        "from the displacement derivatives at the face Gauss points; 'recovered': σ13, σ23, σ33 from the 3D "
+        "equilibrium through the thickness, as in the outputs (less mesh-dependent onset; the recovery treats "
+        "the stack as bonded)")
     friction: Literal["return_mapping", "explicit"] = Field(
         "return_mapping", description="friction as a penalty return mapping (implicit), or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
@@ -509,6 +529,13 @@ class DelaminationDef(Strict):
 
 class OutputDef(Strict):
     vtu: bool = Field(True, description="write the ParaView files (*.vtu, *.pvd)")
+    sampling: Literal["recovered", "raw"] = Field(
+        "recovered", description="stresses in the solid and interface ParaView files: 'recovered' (default) "
+        "transverse stresses σ13, σ23, σ33 from the equilibrium through the thickness, or 'raw' values from the "
+        "displacement derivatives (as [[probes]] sampling)")
+    frame: Literal["material", "global"] = Field(
+        "material", description="stress components in the ParaView files: the layers' material axes (default) "
+        "or the global x, y, z axes")
     plots: bool = Field(True, description="write the PNG figures")
     every: PositiveInt = Field(1, description="write ParaView files every n-th step (the last is always written)")
     zone_steps: list[PositiveInt] | None = Field(

@@ -58,6 +58,9 @@ class DelaminationSettings:
     # False: the thesis's procedure (MODEL.md §9: evaluate once per converged step, no
     # re-equilibration): releases act from the next load step on
     reequilibrate: bool = True
+    # interface tractions of the criterion: "raw" (displacement derivatives at the face Gauss
+    # points, the thesis) or "recovered" (layershell.recovery: equilibrium through the thickness)
+    stresses: str = "raw"
 
 
 @dataclass
@@ -124,7 +127,7 @@ class InterfaceController:
         for r in self.runs:
             blk, itf = r.block, r.block.itf
             ne, nq = blk.w.shape
-            ps = interface_state(model, dm, u, itf, "gauss")
+            ps = interface_state(model, dm, u, itf, "gauss", self.settings.stresses, lam)
             t = ps.traction().reshape(ne, nq, 3)
             m = ps.m.reshape(ne, nq, 3, 3)
             rel = blk.released
