@@ -573,7 +573,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             raise InputError(f"'stacks': {bad.size} element(s) belong to no stack (first: element {bad[0]}); "
                              "add a stack without 'where' or widen the selections")
     model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
-                  nonlinear=mf.model.nonlinear, units=mf.model.units)
+                  nonlinear=mf.model.nonlinear, units=mf.model.units, element=mf.model.element)
     try:
         model.below()
     except ValueError as exc:
