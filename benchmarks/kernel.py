@@ -54,6 +54,9 @@ def main() -> None:
     ap.add_argument("--elements", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--chunk", type=int, default=256)
+    ap.add_argument("--element", choices=["mitc", "full"], default="mitc",
+                    help="kernel timed (default the MITC9 default element); the other one is timed too "
+                         "and the ratio printed")
     a = ap.parse_args()
     side = int(np.ceil(np.sqrt(a.elements)))
     mesh = rectangle(float(side), float(side), side, side)
@@ -61,12 +64,14 @@ def main() -> None:
     ne = len(X)
     th = np.full((ne, 9), 0.1)
     mat = Orthotropic(3.4e4, 3.6e4, 3.4e4, 1.5e4, 1.45e4, 1.45e4, 0.17, 0.17, 0.17)
-    blocks = [layer_block(X, th * k, th, 3, mat, 15.0) for k in (0, 1)]
+    other = "full" if a.element == "mitc" else "mitc"
+    blocks = [layer_block(X, th * k, th, 3, mat, 15.0, element=a.element) for k in (0, 1)]
+    blocks_other = [layer_block(X, th * k, th, 3, mat, 15.0, element=other) for k in (0, 1)]
     rng = np.random.default_rng(1)
     U = [1e-3 * rng.standard_normal((ne, 36, 3)) for _ in blocks]
 
-    def run():
-        for b, u in zip(blocks, U):
+    def run(bl=blocks):
+        for b, u in zip(bl, U):
             for s in range(0, ne, a.chunk):
                 sl = slice(s, s + a.chunk)
                 layer_response(b, u[sl], True, True, sl)
@@ -78,6 +83,9 @@ def main() -> None:
     dev = max(np.abs(f1 - f0).max() / np.abs(f0).max(), np.abs(K1 - K0).max() / np.abs(K0).max())
     run()
     t = min(_timed(run) for _ in range(a.repeat))
+    layer_response(blocks_other[0], U[0][:1], True, True, slice(0, 1))
+    run(blocks_other)
+    t_other = min(_timed(lambda: run(blocks_other)) for _ in range(a.repeat))
     q = blocks[0].dV.shape[1]
     fl = 2 * q * flops_per_point(108) * ne
     achieved = fl / t / 1e9
@@ -85,7 +93,10 @@ def main() -> None:
     print(json.dumps({"elements": ne, "dofs_per_element": 216, "seconds": round(t, 4),
                       "elements_per_second": round(ne / t, 1), "gflops": round(achieved, 3),
                       "roofline_gflops": round(peak, 3), "mflop_per_element": round(fl / ne / 1e6, 3),
-                      "threads": kernel_threads(), "first_call_seconds": round(first, 3),
+                      "threads": kernel_threads(), "element": a.element,
+                      f"seconds_{other}": round(t_other, 4),
+                      "time_ratio_mitc_over_full": round(t / t_other if a.element == "mitc" else t_other / t, 3),
+                      "integration_points_per_layer": q, "first_call_seconds": round(first, 3),
                       "max_rel_deviation_from_reference": float(f"{dev:.2e}"),
                       "load_average": [round(x, 2) for x in os.getloadavg()]}))
     print(f"roofline_share={achieved / peak:.4f}")

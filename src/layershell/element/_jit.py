@@ -95,3 +95,132 @@ def add_geometric(K, Kg):  # pragma: no cover
                 v = Kg[e, a, b]
                 for i in range(3):
                     K[e, 3 * a + i, 3 * b + i] += v
+
+
+@njit(cache=True, nogil=True)
+def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo,
+               f, X, GS, GT):  # pragma: no cover
+    """MITC9 layer kernel per element and thickness level (``mitc.py``): covariant strains and
+    their rows at the sampling points, tied to the Gauss points; internal force f (e, a, 3),
+    on request X (e, z·9, 6, a, 3) = Lᵀ B̃ (L the factor of the covariant stiffness C̃, or any
+    map) and the geometric operands GS = ∂phi σ, GT = ∂phi (e, a, columns)."""
+    ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
+    nd = d + 1
+    na = 9 * nd
+    T = pts.shape[1]
+    dphi = np.empty((P, na, 3))
+    gg = np.empty((P, 3, 3))
+    D = np.empty((3, 3))
+    Ecov = np.empty((P, 6))
+    Bc = np.empty((6, T, na, 3))
+    Bt = np.empty((6, na, 3))
+    sig = np.empty((P, 3, 3))
+    Et = np.empty(6)
+    S = np.empty(6)
+    pw = np.empty(nd)
+    dpw = np.empty(nd)
+    pi = np.array([0, 1, 2, 1, 0, 0])
+    pj = np.array([0, 1, 2, 2, 2, 1])
+    for e in range(ne):
+        for a in range(na):
+            for k in range(3):
+                f[e, a, k] = 0.0
+        col = 0
+        for z in range(nz):
+            for p in range(P):
+                th = thL[e, z, p]
+                for l in range(nd):
+                    pw[l] = th ** l
+                    dpw[l] = l * th ** (l - 1) if l > 0 else 0.0
+                for n in range(9):
+                    for l in range(nd):
+                        a = n * nd + l
+                        dphi[p, a, 0] = dNn[p, n, 0] * pw[l]
+                        dphi[p, a, 1] = dNn[p, n, 1] * pw[l]
+                        dphi[p, a, 2] = Nn[p, n] * dpw[l]
+                for i in range(3):
+                    for k in range(3):
+                        D[i, k] = 0.0
+                for a in range(na):
+                    for i in range(3):
+                        da = dphi[p, a, i]
+                        for k in range(3):
+                            D[i, k] += da * U[e, a, k]
+                for i in range(3):
+                    for k in range(3):
+                        gg[p, i, k] = G[e, z, p, k, i] + (D[i, k] if nonlinear else 0.0)
+                for c in range(6):
+                    i, j = pi[c], pj[c]
+                    s = 0.0
+                    for k in range(3):
+                        s += 0.5 * (G[e, z, p, k, i] * D[j, k] + D[i, k] * G[e, z, p, k, j])
+                        if nonlinear:
+                            s += 0.5 * D[i, k] * D[j, k]
+                    Ecov[p, c] = s if i == j else 2.0 * s
+                for i in range(3):
+                    for j in range(3):
+                        sig[p, i, j] = 0.0
+            for c in range(6):
+                i, j = pi[c], pj[c]
+                for t in range(nt[c]):
+                    p = pts[c, t]
+                    for a in range(na):
+                        if i == j:
+                            di = dphi[p, a, i]
+                            for k in range(3):
+                                Bc[c, t, a, k] = gg[p, i, k] * di
+                        else:
+                            di, dj = dphi[p, a, i], dphi[p, a, j]
+                            for k in range(3):
+                                Bc[c, t, a, k] = gg[p, i, k] * dj + gg[p, j, k] * di
+            for q in range(9):
+                for c in range(6):
+                    s = 0.0
+                    for t in range(nt[c]):
+                        s += w[c, q, t] * Ecov[pts[c, t], c]
+                    Et[c] = s
+                for c in range(6):
+                    s = 0.0
+                    for c2 in range(6):
+                        s += Ct[e, z, q, c, c2] * Et[c2]
+                    S[c] = s
+                for c in range(6):
+                    for a in range(na):
+                        for k in range(3):
+                            Bt[c, a, k] = 0.0
+                    for t in range(nt[c]):
+                        wt = w[c, q, t]
+                        if wt != 0.0:
+                            for a in range(na):
+                                for k in range(3):
+                                    Bt[c, a, k] += wt * Bc[c, t, a, k]
+                    for a in range(na):
+                        for k in range(3):
+                            f[e, a, k] += S[c] * Bt[c, a, k]
+                if want_x:
+                    r = z * 9 + q
+                    for W in range(6):
+                        l0, l1, l2 = L[e, z, q, 0, W], L[e, z, q, 1, W], L[e, z, q, 2, W]
+                        l3, l4, l5 = L[e, z, q, 3, W], L[e, z, q, 4, W], L[e, z, q, 5, W]
+                        for a in range(na):
+                            for k in range(3):
+                                X[e, r, W, a, k] = (l0 * Bt[0, a, k] + l1 * Bt[1, a, k] + l2 * Bt[2, a, k]
+                                                    + l3 * Bt[3, a, k] + l4 * Bt[4, a, k] + l5 * Bt[5, a, k])
+                if want_geo:
+                    for c in range(6):
+                        i, j = pi[c], pj[c]
+                        for t in range(nt[c]):
+                            v = w[c, q, t] * S[c]
+                            p = pts[c, t]
+                            sig[p, i, j] += v
+                            if i != j:
+                                sig[p, j, i] += v
+            if want_geo:
+                for p in range(P):
+                    for r in range(ndir[p]):
+                        K = dirs[p, r]
+                        for a in range(na):
+                            GS[e, a, col] = dphi[p, a, 0] * sig[p, 0, K] + dphi[p, a, 1] * sig[p, 1, K] \
+                                + dphi[p, a, 2] * sig[p, 2, K]
+                            GT[e, a, col] = dphi[p, a, K]
+                        col += 1
