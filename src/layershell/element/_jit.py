@@ -97,23 +97,25 @@ def add_geometric(K, Kg):  # pragma: no cover
                     K[e, 3 * a + i, 3 * b + i] += v
 
 
-@njit(cache=True, nogil=True)
-def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo,
+@njit(cache=True, nogil=True, fastmath=True)
+def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo, lower,
                f, X, GS, GT):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``): covariant strains and
-    their rows at the sampling points, tied to the Gauss points; internal force f (e, a, 3),
-    on request X (e, z·9, 6, a, 3) = Lᵀ B̃ (L the factor of the covariant stiffness C̃, or any
-    map) and the geometric operands GS = ∂phi σ, GT = ∂phi (e, a, columns)."""
+    their rows at the sampling points, tied to the Gauss points; internal force f (e, m) with
+    m = 3a (DOF index 3·a + k), on request X (e, z·9, 6, m) = Lᵀ B̃ (L the lower factor of the
+    covariant stiffness C̃ when ``lower``, else any map) and the geometric operands
+    GS = ∂phi σ, GT = ∂phi (e, a, columns)."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
     nd = d + 1
     na = 9 * nd
+    m = 3 * na
     T = pts.shape[1]
     dphi = np.empty((P, na, 3))
     gg = np.empty((P, 3, 3))
     D = np.empty((3, 3))
     Ecov = np.empty((P, 6))
-    Bc = np.empty((6, T, na, 3))
-    Bt = np.empty((6, na, 3))
+    Bc = np.empty((6, T, m))
+    Bt = np.empty((6, m))
     sig = np.empty((P, 3, 3))
     Et = np.empty(6)
     S = np.empty(6)
@@ -122,9 +124,8 @@ def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, 
     pi = np.array([0, 1, 2, 1, 0, 0])
     pj = np.array([0, 1, 2, 2, 2, 1])
     for e in range(ne):
-        for a in range(na):
-            for k in range(3):
-                f[e, a, k] = 0.0
+        for r in range(m):
+            f[e, r] = 0.0
         col = 0
         for z in range(nz):
             for p in range(P):
@@ -164,15 +165,19 @@ def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, 
                 i, j = pi[c], pj[c]
                 for t in range(nt[c]):
                     p = pts[c, t]
+                    gi0, gi1, gi2 = gg[p, i, 0], gg[p, i, 1], gg[p, i, 2]
+                    gj0, gj1, gj2 = gg[p, j, 0], gg[p, j, 1], gg[p, j, 2]
                     for a in range(na):
                         if i == j:
                             di = dphi[p, a, i]
-                            for k in range(3):
-                                Bc[c, t, a, k] = gg[p, i, k] * di
+                            Bc[c, t, 3 * a] = gi0 * di
+                            Bc[c, t, 3 * a + 1] = gi1 * di
+                            Bc[c, t, 3 * a + 2] = gi2 * di
                         else:
                             di, dj = dphi[p, a, i], dphi[p, a, j]
-                            for k in range(3):
-                                Bc[c, t, a, k] = gg[p, i, k] * dj + gg[p, j, k] * di
+                            Bc[c, t, 3 * a] = gi0 * dj + gj0 * di
+                            Bc[c, t, 3 * a + 1] = gi1 * dj + gj1 * di
+                            Bc[c, t, 3 * a + 2] = gi2 * dj + gj2 * di
             for q in range(9):
                 for c in range(6):
                     s = 0.0
@@ -185,27 +190,34 @@ def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, 
                         s += Ct[e, z, q, c, c2] * Et[c2]
                     S[c] = s
                 for c in range(6):
-                    for a in range(na):
-                        for k in range(3):
-                            Bt[c, a, k] = 0.0
+                    first = True
                     for t in range(nt[c]):
                         wt = w[c, q, t]
                         if wt != 0.0:
-                            for a in range(na):
-                                for k in range(3):
-                                    Bt[c, a, k] += wt * Bc[c, t, a, k]
-                    for a in range(na):
-                        for k in range(3):
-                            f[e, a, k] += S[c] * Bt[c, a, k]
+                            if first:
+                                for r in range(m):
+                                    Bt[c, r] = wt * Bc[c, t, r]
+                                first = False
+                            else:
+                                for r in range(m):
+                                    Bt[c, r] += wt * Bc[c, t, r]
+                    if first:
+                        for r in range(m):
+                            Bt[c, r] = 0.0
+                    sc = S[c]
+                    for r in range(m):
+                        f[e, r] += sc * Bt[c, r]
                 if want_x:
-                    r = z * 9 + q
+                    row = z * 9 + q
                     for W in range(6):
-                        l0, l1, l2 = L[e, z, q, 0, W], L[e, z, q, 1, W], L[e, z, q, 2, W]
-                        l3, l4, l5 = L[e, z, q, 3, W], L[e, z, q, 4, W], L[e, z, q, 5, W]
-                        for a in range(na):
-                            for k in range(3):
-                                X[e, r, W, a, k] = (l0 * Bt[0, a, k] + l1 * Bt[1, a, k] + l2 * Bt[2, a, k]
-                                                    + l3 * Bt[3, a, k] + l4 * Bt[4, a, k] + l5 * Bt[5, a, k])
+                        c0 = W if lower else 0
+                        lw = L[e, z, q, c0, W]
+                        for r in range(m):
+                            X[e, row, W, r] = lw * Bt[c0, r]
+                        for c in range(c0 + 1, 6):
+                            lw = L[e, z, q, c, W]
+                            for r in range(m):
+                                X[e, row, W, r] += lw * Bt[c, r]
                 if want_geo:
                     for c in range(6):
                         i, j = pi[c], pj[c]

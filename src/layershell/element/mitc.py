@@ -280,13 +280,13 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         t = min(s + _SUB, hi)
         nb = t - s
         g0, g1 = sl0 + s, sl0 + t
-        X = np.empty((nb, nz * 9, 6, a, 3) if tangent else (0, 0, 0, 0, 0))
+        X = np.empty((nb, nz * 9, 6, m) if tangent else (0, 0, 0, 0))
         GS = np.empty((nb, a, ncol) if geo else (0, 0, 0))
         GT = np.empty_like(GS)
         Ct = block.Ct[g0:g1]
         Lf = block.L[g0:g1] if block.L is not None else Ct
         _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
-                        tie.ndir, Ct, Lf, U[s:t], d, nonlinear, tangent, geo, f[s:t], X, GS, GT)
+                        tie.ndir, Ct, Lf, U[s:t], d, nonlinear, tangent, geo, block.L is not None, f[s:t], X, GS, GT)
         if not tangent:
             continue
         Xr = X.reshape(nb, 6 * nz * 9, m)
@@ -296,7 +296,7 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
             B = np.empty_like(X)
             eye = np.ascontiguousarray(np.broadcast_to(np.eye(6), Ct.shape))
             _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
-                            tie.ndir, Ct, eye, U[s:t], d, nonlinear, True, False, np.empty((nb, a, 3)), B, GS, GT)
+                            tie.ndir, Ct, eye, U[s:t], d, nonlinear, True, False, False, np.empty((nb, m)), B, GS, GT)
             np.matmul(B.reshape(nb, 6 * nz * 9, m).transpose(0, 2, 1), Xr, out=K[s:t])
         if geo:
             _jit.add_geometric(K[s:t], np.matmul(GS, GT.transpose(0, 2, 1)))
@@ -319,7 +319,7 @@ def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tange
     e = hi0 - lo0
     a = 9 * (block.d + 1)
     m = 3 * a
-    f = np.empty((e, a, 3))
+    f = np.empty((e, m))
     K = np.empty((e, m, m)) if tangent else None
     n_threads = min(kernel_threads(), max(1, e // _SUB))
     with _blas_single_thread() if tangent else nullcontext():
@@ -331,4 +331,4 @@ def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tange
                     for lo, hi in zip(bounds[:-1], bounds[1:])]
             for j in jobs:
                 j.result()
-    return f.reshape(e, m), K
+    return f, K
