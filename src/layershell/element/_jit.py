@@ -98,7 +98,7 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo, lower,
+def mitc_terms(Nn, dNn, thL, G, M, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo, lower,
                f, X, GS, GT):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``): covariant strains and
     their rows at the sampling points, tied to the Gauss points; internal force f (e, m) with
@@ -136,9 +136,11 @@ def mitc_terms(Nn, dNn, thL, G, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, 
                 for n in range(9):
                     for l in range(nd):
                         a = n * nd + l
-                        dphi[p, a, 0] = dNn[p, n, 0] * pw[l]
-                        dphi[p, a, 1] = dNn[p, n, 1] * pw[l]
-                        dphi[p, a, 2] = Nn[p, n] * dpw[l]
+                        d0 = dNn[p, n, 0] * pw[l]
+                        d1 = dNn[p, n, 1] * pw[l]
+                        d2 = Nn[p, n] * dpw[l]
+                        for b in range(3):  # derivative along the frame vector F_b
+                            dphi[p, a, b] = d0 * M[e, z, p, 0, b] + d1 * M[e, z, p, 1, b] + d2 * M[e, z, p, 2, b]
                 for i in range(3):
                     for k in range(3):
                         D[i, k] = 0.0

@@ -142,7 +142,7 @@ class MitcBlock:
     """Reference data of one layer over a group of elements for the MITC9 kernel.
 
     N (P, 9), dN (P, 9, 2): shape functions at the sampling points; thL (e, z, P): Θ_L³ there
-    G (e, z, P, 3, 3): covariant base vectors G_i (columns) there
+    G (e, z, P, 3, 3): the strain frame vectors F_b (columns) there; M (e, z, P, 3, 3) = G⁻¹F
     Ct (e, z, 9, 6, 6): covariant stiffness Tᵀ C T dV at the Gauss points; L: its Cholesky factor
     or None; C (e, z·9, 6, 6), dV (e, z·9): Cartesian stiffness and volume weights (z-major)
     """
@@ -153,6 +153,7 @@ class MitcBlock:
     dN: np.ndarray
     thL: np.ndarray
     G: np.ndarray
+    M: np.ndarray
     Ct: np.ndarray
     L: np.ndarray | None
     C: np.ndarray
@@ -163,28 +164,63 @@ class MitcBlock:
         return 27 * (self.d + 1)
 
 
+def _rotation(n0: np.ndarray, n1: np.ndarray) -> np.ndarray:
+    """Smallest rotation taking unit vectors ``n0`` to ``n1`` (..., 3, 3) (Rodrigues)."""
+    v = np.cross(n0, n1)
+    c = np.sum(n0 * n1, axis=-1)
+    Z = np.zeros_like(c)
+    W = np.stack([np.stack([Z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], Z, -v[..., 0]], -1),
+                  np.stack([-v[..., 1], v[..., 0], Z], -1)], -2)
+    return np.eye(3) + W + (W @ W) / (1.0 + c)[..., None, None]
+
+
+def strain_frames(X, H_below, H, points, zeta, frame: str = "center"):
+    """Covariant bases in which strains are tied, at in-plane ``points (P, 2)`` and thickness
+    levels ``zeta``: ``(F, M, G, Ginv, detG, sp, thL)`` with F (e, P, z, 3, 3) the frame vectors
+    F_b as columns and M = G⁻¹F (so that the derivative along F_b is Σ_i M_ib ∂_i).
+
+    ``frame = "natural"``: F = G, the convected base vectors (Bucalem & Bathe 1993).
+    ``frame = "center"``: F_α = R(p) G_α(centre), F_3 = A_3(p), with R(p) the smallest rotation
+    taking the normal at the element centre to the normal at p (same natural level ζ). On a flat
+    element the frame is constant, so a constant strain is tied exactly on any distorted mesh
+    (patch test); on a regular curved element (cylinder) it equals the natural frame. The
+    constant-Jacobian idea of the MITC9i element (Wisniewski & Turska 2018, Comput. Mech. 62).
+    """
+    sp = surface_points(X, points[:, 0], points[:, 1])
+    Hp, Hbp = sp.interpolate(H), sp.interpolate(H_below)  # (e, P)
+    thL = 0.5 * Hp[..., None] * (zeta + 1.0)  # (e, P, z)
+    G, Ginv, detG = shell_basis(sp, Hbp[..., None] + thL)  # (e, P, z, 3, 3)
+    if frame == "natural":
+        F = G
+    elif frame == "center":
+        sc = surface_points(X, np.zeros(1), np.zeros(1))
+        tc = 0.5 * sc.interpolate(H)[..., None] * (zeta + 1.0)
+        Gc, _, _ = shell_basis(sc, sc.interpolate(H_below)[..., None] + tc)  # (e, 1, z, 3, 3)
+        R = _rotation(sc.A3, sp.A3)  # (e, P, 3, 3)
+        Fa = np.einsum("epij,ezja->epzia", R, Gc[:, 0, :, :, :2])
+        F = np.concatenate([Fa, np.broadcast_to(sp.A3[:, :, None, :, None], Fa.shape[:-1] + (1,))], axis=-1)
+    else:
+        raise ValueError(f"unknown strain frame {frame!r}")
+    M = np.einsum("epziJ,epzJb->epzib", Ginv, F)
+    return F, M, G, Ginv, detG, sp, thL
+
+
 def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 0.0, direction=None,
-               n_thickness: int = 3, full: bool = False) -> MitcBlock:
-    """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`)."""
+               n_thickness: int = 3, full: bool = False, frame: str = "center") -> MitcBlock:
+    """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`;
+    ``frame`` see :func:`strain_frames`)."""
     from .kernel import material_frame
 
     tie = tying(full)
     zeta, wz = gauss_1d(n_thickness)
     gp, w2 = gauss_2d(3)
-    # sampling points (ties + Gauss points)
-    sp = surface_points(X, tie.points[:, 0], tie.points[:, 1])
-    Hp, Hbp = sp.interpolate(H), sp.interpolate(H_below)  # (e, P)
-    thL = 0.5 * Hp[..., None] * (zeta + 1.0)  # (e, P, z)
-    G, _, _ = shell_basis(sp, Hbp[..., None] + thL)  # (e, P, z, 3, 3)
-    # Gauss points
-    sg = surface_points(X, gp[:, 0], gp[:, 1])
-    Hq, Hbq = sg.interpolate(H), sg.interpolate(H_below)
-    tq = 0.5 * Hq[..., None] * (zeta + 1.0)
-    _, Ginv, detG = shell_basis(sg, Hbq[..., None] + tq)  # (e, q, z, ...)
+    F, M, _, _, _, _, thL = strain_frames(X, H_below, H, tie.points, zeta, frame)  # sampling points
+    Fq, _, _, _, detG, sg, _ = strain_frames(X, H_below, H, gp, zeta, frame)  # Gauss points
+    Hq = sg.interpolate(H)
     dV = detG * (w2[:, None] * wz[None, :]) * (0.5 * Hq[..., None])  # (e, q, z)
-    frame = material_frame(sg, angle_deg, direction)
-    C = rotate_stiffness(material.stiffness(), frame)  # (e, q, 6, 6)
-    T = covariant_map(Ginv)  # (e, q, z, 6, 6)
+    mframe = material_frame(sg, angle_deg, direction)
+    C = rotate_stiffness(material.stiffness(), mframe)  # (e, q, 6, 6)
+    T = covariant_map(np.linalg.inv(Fq))  # (e, q, z, 6, 6): rows of F⁻¹ = dual vectors F^i
     Ct = np.einsum("eqzVc,eqVW,eqzWd->ezqcd", T, C, T) * dV.transpose(0, 2, 1)[..., None, None]
     Ct = np.ascontiguousarray(0.5 * (Ct + np.swapaxes(Ct, -1, -2)))
     L = None
@@ -197,8 +233,8 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
     Cz = np.ascontiguousarray(np.broadcast_to(C[:, None], (e, z, q, 6, 6)).reshape(e, z * q, 6, 6))
     N, dN, _ = _quad9(tie.points)
     return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
-                     np.ascontiguousarray(G.transpose(0, 2, 1, 3, 4)), Ct, L, Cz,
-                     np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)))
+                     np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),
+                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)))
 
 
 def _quad9(points):
@@ -224,7 +260,7 @@ def natural_gradients(block: MitcBlock, sl: slice = slice(None)) -> np.ndarray:
 def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tangent: bool = True,
                             sl: slice = slice(None)):
     """Plain NumPy form of the MITC9 layer response (module docstring): ``f (e, m)``, ``K (e, m, m)``."""
-    dphi = natural_gradients(block, sl)  # (e, z, P, a, i)
+    dphi = np.einsum("ezpai,ezpib->ezpab", natural_gradients(block, sl), block.M[sl])  # along F_b
     Gc = np.swapaxes(block.G[sl], -1, -2)  # (e, z, P, i, k): G_i components k
     Ct = block.Ct[sl]
     H = block.tie.dense()  # (c, q, P)
@@ -285,7 +321,7 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         GT = np.empty_like(GS)
         Ct = block.Ct[g0:g1]
         Lf = block.L[g0:g1] if block.L is not None else Ct
-        _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
+        _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
                         tie.ndir, Ct, Lf, U[s:t], d, nonlinear, tangent, geo, block.L is not None, f[s:t], X, GS, GT)
         if not tangent:
             continue
@@ -295,7 +331,7 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         else:  # C̃ not positive definite: K = B̃ᵀ (C̃ B̃), B̃ from the identity map
             B = np.empty_like(X)
             eye = np.ascontiguousarray(np.broadcast_to(np.eye(6), Ct.shape))
-            _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
+            _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
                             tie.ndir, Ct, eye, U[s:t], d, nonlinear, True, False, False, np.empty((nb, m)), B, GS, GT)
             np.matmul(B.reshape(nb, 6 * nz * 9, m).transpose(0, 2, 1), Xr, out=K[s:t])
         if geo:
