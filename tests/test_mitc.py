@@ -246,3 +246,35 @@ def test_centre_frame_passes_the_membrane_patch_test_natural_frame_does_not(rng,
         errors[frame] = np.abs(ps.u[:, 0] - sig * ps.X[:, 0] / E).max() / (2 * sig / E)
     assert errors["center"] < 1e-10
     assert errors["natural"] > 1e-6
+
+
+def test_tied_strain_at_points_equals_the_kernel_strain(rng):
+    """tied_strain (used by probes, profiles and the delamination criterion) at the Gauss points
+    and thickness levels of the kernel = the kernel's tied strain there (from its stress: C̃⁻¹ S̃
+    per point, then to Cartesian axes): one strain field for the stiffness and the output."""
+    from layershell.element import mitc
+    from layershell.element.quadrature import gauss_1d, gauss_2d
+
+    d, nz = 2, 3
+    X = curved_element(rng, distort=0.15)
+    Hb, H = _layer(rng)
+    U = 0.05 * rng.standard_normal((1, 9 * (d + 1), 3))
+    blk = mitc_block(X, Hb, H, d, ORTHO, 20.0, n_thickness=nz)
+    # kernel's tied covariant strain at (z, q): from its internal algebra (reference form)
+    dphi = np.einsum("ezpai,ezpib->ezpab", mitc.natural_gradients(blk), blk.M)
+    Gc = np.swapaxes(blk.G, -1, -2)
+    D = np.einsum("ezpai,eak->ezpik", dphi, U)
+    GD = np.einsum("ezpik,ezpjk->ezpij", Gc, D)
+    E = 0.5 * (GD + np.swapaxes(GD, -1, -2)) + 0.5 * np.einsum("ezpik,ezpjk->ezpij", D, D)
+    Ev = np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in mitc._PAIRS], axis=-1)
+    Et = np.einsum("cqp,ezpc->ezqc", tying().dense(), Ev)[0]  # (z, q, 6)
+    gp, _ = gauss_2d(3)
+    zeta, _ = gauss_1d(nz)
+    Fq = mitc.strain_frames(X, Hb, H, gp, zeta)[0][0]  # (q, z, 3, 3)
+    want = np.einsum("qzVc,zqc->zqV", mitc.covariant_map(np.linalg.inv(Fq)), Et)
+    Hq = np.einsum("qn,n->q", mitc._quad9(gp)[0], H[0])
+    for z in range(nz):
+        thL = 0.5 * Hq * (zeta[z] + 1)
+        got = mitc.tied_strain(np.repeat(X, 9, 0), np.repeat(Hb, 9, 0), np.repeat(H, 9, 0), d,
+                               np.repeat(U, 9, 0), gp[:, 0].copy(), gp[:, 1].copy(), thL)
+        assert np.allclose(got, want[z], rtol=1e-10, atol=1e-12 * np.abs(want).max())

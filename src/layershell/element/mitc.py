@@ -368,3 +368,77 @@ def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tange
             for j in jobs:
                 j.result()
     return f, K
+
+
+def tying_functions(xi: np.ndarray, eta: np.ndarray) -> list[np.ndarray]:
+    """MITC9 tying functions at arbitrary points: per Voigt component c the weights
+    ``(s, n_c)`` of its ties (E_33: none, it is taken at the point itself)."""
+    a, b = A_TIE, B_TIE
+    la, lb = np.array([-a, a]), np.array([-b, 0.0, b])
+    s = len(xi)
+    hA = np.einsum("qi,qj->qij", _lagrange(la, xi), _lagrange(lb, eta)).reshape(s, 6)
+    hB = np.einsum("qi,qj->qij", _lagrange(lb, xi), _lagrange(la, eta)).reshape(s, 6)
+    hC = np.einsum("qi,qj->qij", _lagrange(la, xi), _lagrange(la, eta)).reshape(s, 4)
+    return [hA, hB, None, hB, hA, hC]
+
+
+def tied_strain(X: np.ndarray, H_below: np.ndarray, H: np.ndarray, d: int, U: np.ndarray, xi: np.ndarray,
+                eta: np.ndarray, thL: np.ndarray, nonlinear: bool = True, frame: str = "center") -> np.ndarray:
+    """Cartesian Voigt Green-Lagrange strain (engineering shear) of the MITC9 element at points
+    ``(xi, eta, Θ_L)`` of elements ``X (s, 9, 3)`` with nodal vectors ``U (s, a, 3)``: the strain
+    the element's stress is computed from (tied E_11, E_22, E_12, E_13, E_23 interpolated from the
+    tying points at the point's natural thickness level, E_33 at the point), so probes, profiles
+    and the delamination criterion see the element's own strain field."""
+    tie = tying()
+    s = len(xi)
+    zeta = (2.0 * thL / np.einsum("sn,sn->s", _quad9(np.stack([xi, eta], -1))[0], H) - 1.0)[:, None, None]
+    pts = np.concatenate([tie.points[:16], np.zeros((1, 2))])  # ties + the point itself (per element)
+    Ffr, M, _, _, _, _, thp = strain_frames(X, H_below, H, pts, zeta, frame)  # (s, 17, 1, ...)
+    # the point itself: evaluate per element at its (xi, eta)
+    Fp, Mp, _, _, _, _, thq = _point_frames(X, H_below, H, xi, eta, zeta, frame)
+    F = np.concatenate([Ffr[:, :16, 0], Fp], axis=1)  # (s, 17, 3, 3)
+    Mm = np.concatenate([M[:, :16, 0], Mp], axis=1)
+    th = np.concatenate([thp[:, :16, 0], thq], axis=1)  # (s, 17)
+    N, dN, _ = _quad9(tie.points[:16])
+    Nq, dNq, _ = _quad9(np.stack([xi, eta], -1))
+    l = np.arange(d + 1)
+    pw, dpw = th[..., None] ** l, np.where(l > 0, l * th[..., None] ** np.maximum(l - 1, 0), 0.0)
+    dNall = np.concatenate([np.broadcast_to(dN, (s,) + dN.shape), dNq[:, None]], axis=1)  # (s, 17, 9, 2)
+    Nall = np.concatenate([np.broadcast_to(N, (s,) + N.shape), Nq[:, None]], axis=1)
+    d12 = np.einsum("spna,spl->spnla", dNall, pw)
+    d3 = np.einsum("spn,spl->spnl", Nall, dpw)[..., None]
+    dphi = np.concatenate([d12, d3], -1).reshape(s, 17, 9 * (d + 1), 3)
+    dphi = np.einsum("spai,spib->spab", dphi, Mm)
+    Gc = np.swapaxes(F, -1, -2)
+    D = np.einsum("spai,sak->spik", dphi, U)
+    GD = np.einsum("spik,spjk->spij", Gc, D)
+    E = 0.5 * (GD + np.swapaxes(GD, -1, -2))
+    if nonlinear:
+        E = E + 0.5 * np.einsum("spik,spjk->spij", D, D)
+    Ev = np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in _PAIRS], axis=-1)  # (s, 17, 6)
+    h = tying_functions(xi, eta)
+    idx = {0: slice(0, 6), 4: slice(0, 6), 1: slice(6, 12), 3: slice(6, 12), 5: slice(12, 16)}
+    Et = np.empty((s, 6))
+    for c in range(6):
+        Et[:, c] = Ev[:, 16, c] if c == 2 else np.einsum("st,st->s", h[c], Ev[:, idx[c], c])
+    T = covariant_map(np.linalg.inv(F[:, 16]))
+    return np.einsum("sVc,sc->sV", T, Et)
+
+
+def _point_frames(X, H_below, H, xi, eta, zeta, frame):
+    """:func:`strain_frames` at one point per element ``(xi[s], eta[s])`` (level ``zeta (s,1,1)``)."""
+    sp = surface_points(X, xi[:, None], eta[:, None], per_element=True)
+    Hp, Hbp = sp.interpolate(H), sp.interpolate(H_below)  # (s, 1)
+    thL = 0.5 * Hp[..., None] * (zeta + 1.0)  # (s, 1, 1)
+    G, Ginv, _ = shell_basis(sp, Hbp[..., None] + thL)
+    if frame == "natural":
+        F = G
+    else:
+        sc = surface_points(X, np.zeros(1), np.zeros(1))
+        tc = 0.5 * sc.interpolate(H)[..., None] * (zeta + 1.0)
+        Gcen, _, _ = shell_basis(sc, sc.interpolate(H_below)[..., None] + tc)
+        R = _rotation(sc.A3, sp.A3)
+        Fa = np.einsum("epij,ezja->epzia", R, Gcen[:, 0, :, :, :2])
+        F = np.concatenate([Fa, np.broadcast_to(sp.A3[:, :, None, :, None], Fa.shape[:-1] + (1,))], axis=-1)
+    M = np.einsum("epziJ,epzJb->epzib", Ginv, F)
+    return F[:, :, 0], M[:, :, 0], None, None, None, None, thL[:, :, 0]
