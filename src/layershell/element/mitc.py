@@ -23,6 +23,13 @@ C̃ = Tᵀ C T dV (T the Voigt form of that map), so that with S̃ = C̃ Ẽ
 (the geometric part from the exact second derivatives of the tied strains; h_c the tying
 functions). The total-Lagrangian form of the full element (``kernel.py``) is the special case
 "every component sampled at the Gauss point"; :func:`tying` with ``full=True`` gives it (test).
+
+The components are taken in a frame F_b (:func:`strain_frames`): by default the centre frame
+transported to each point (so that the membrane patch test is exact on straight-edged distorted
+elements), or the natural convected basis G_i of the original MITC9 (``frame="natural"``); the
+formulas above hold with G_i → F_b and ∂_i → the derivative along F_b. At least d + 1 thickness
+points are used. :func:`tied_strain` gives the same tied strain at any point (probes, profiles,
+delamination criterion via ``results.evaluate_points``).
 """
 from __future__ import annotations
 
