@@ -136,7 +136,7 @@ def test_run_writes_the_figures(tmp_path):
     assert d["max_u"] == pytest.approx(umax, rel=1e-12)
     assert d["color_range"][0] == pytest.approx(0.0, abs=1e-12)  # the clamped end does not move
     assert umax <= d["color_range"][1] <= umax * (1 + 1e-3)  # sampled surface: nodes included
-    assert abs(res.summary["probes"]["w_tip"] - 4.0125) < 1e-3  # the validated result (README)
+    assert abs(res.summary["probes"]["w_tip"] - 4.0205) < 1e-3  # the validated result (README; MITC9)
     lw = info["load_displacement_w_tip.png"]["range"]
     assert lw[1] == pytest.approx(res.summary["probes"]["w_tip"])
 

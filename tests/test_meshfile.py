@@ -62,7 +62,7 @@ def test_model_with_a_mesh_file_and_named_sets(tmp_path):
                         'type = "file"\npath = "beam.msh"')
     text = text.replace('type = "symmetry"\nwhere = "near(x, 0)"', 'type = "symmetry"\nset = "clamp"')
     spec = build(parse(text), tmp_path)
-    assert abs(run(spec).summary["probes"]["w_tip"] - 4.0125) < 1e-3
+    assert abs(run(spec).summary["probes"]["w_tip"] - 4.0205) < 1e-3  # the example (MITC9 default)
 
 
 def test_generated_meshes_name_their_edges():

@@ -12,11 +12,26 @@ from layershell.solver.problem import Problem
 from layershell.io.build import boundary_edges
 
 
-def _distorted_plate(rng, lx=2.0, ly=1.0, nx=3, ny=2):
+def _distorted_plate(rng, lx=2.0, ly=1.0, nx=3, ny=2, straight=False):
+    """Distorted plate mesh: inner nodes moved at random (curved element edges), or with
+    ``straight`` the inner corner nodes moved and the other nodes placed on the bilinear map of
+    each element (straight-edged quadrilaterals, the MacNeal-Harder patch-test kind)."""
     m = rectangle(lx, ly, nx, ny)
     x = m.nodes
     inner = (x[:, 0] > 1e-9) & (x[:, 0] < lx - 1e-9) & (x[:, 1] > 1e-9) & (x[:, 1] < ly - 1e-9)
-    m.nodes[inner, :2] += 0.08 * rng.uniform(-1, 1, (inner.sum(), 2))
+    if not straight:
+        m.nodes[inner, :2] += 0.08 * rng.uniform(-1, 1, (inner.sum(), 2))
+    else:
+        from layershell.element.shape import NODE_XI
+
+        corners = np.unique(m.elements[:, :4])
+        corners = corners[inner[corners]]
+        m.nodes[corners, :2] += 0.12 * rng.uniform(-1, 1, (corners.size, 2))
+        xi, eta = NODE_XI[4:, 0], NODE_XI[4:, 1]
+        N4 = 0.25 * np.stack([(1 - xi) * (1 - eta), (1 + xi) * (1 - eta), (1 + xi) * (1 + eta),
+                              (1 - xi) * (1 + eta)], -1)
+        for el in m.elements:
+            m.nodes[el[4:]] = N4 @ m.nodes[el[:4]]
     m.check()
     return m
 
@@ -28,10 +43,17 @@ def _edges(m, mask):
 
 @pytest.mark.parametrize("d", [1, 2, 3])
 @pytest.mark.parametrize("nonlinear", [False])
-def test_membrane_patch_constant_stress(rng, d, nonlinear):
+@pytest.mark.parametrize("element", ["mitc", "full"])
+def test_membrane_patch_constant_stress(rng, d, nonlinear, element):
     """Uniaxial traction σ on the x = lx edge of a distorted mesh: the stress is σ at every
-    point (exact), the other components vanish, and u_x = σ x / E."""
-    m = _distorted_plate(rng)
+    point (exact), the other components vanish, and u_x = σ x / E.
+
+    The fully integrated element is exact on curved-edged distorted elements too; the MITC9
+    element (strains tied in the rotated centre frame) on straight-edged distorted elements, as
+    MITC9 elements in general (with curved edges the tied B̃ no longer integrates to the B of
+    a constant stress: 0.26 % error of u_x on this mesh; the natural-frame MITC9 of Bucalem &
+    Bathe misses even straight-edged distortion, 3e-5, see tests/test_mitc.py)."""
+    m = _distorted_plate(rng, straight=element == "mitc")
     E, nu, H, sig = 1000.0, 0.3, 0.1, 2.0
     x = m.nodes
     ly = Layer("p", Orthotropic.isotropic(E, nu), d, np.full(m.n_nodes, H))
@@ -43,7 +65,7 @@ def test_membrane_patch_constant_stress(rng, d, nonlinear):
                   symmetries=[Symmetry(x0, np.array([1.0, 0, 0])), Symmetry(y0, np.array([0, 1.0, 0]))],
                   edge_loads=[EdgeLoad(_edges(m, np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0]),
                                        lambda theta3, **kw: sig + 0 * theta3)],
-                  nonlinear=nonlinear)
+                  nonlinear=nonlinear, element=element)
     pb = Problem.build(model)
     st = list(load_steps(pb, np.array([1.0])))[-1]
     n = 40

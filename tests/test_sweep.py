@@ -117,4 +117,4 @@ def test_failed_variant_is_a_row(tmp_path):
         rows = list(csv.DictReader(f))
     assert [r["converged"] for r in rows] == ["False", "True"]
     assert "no convergence" in rows[0]["error"] and rows[0]["w_tip"] == ""
-    assert float(rows[1]["w_tip"]) == pytest.approx(4.0125, rel=1e-3)  # the linear solve: one iteration
+    assert float(rows[1]["w_tip"]) == pytest.approx(4.0205, rel=1e-3)  # the linear solve (MITC9): one iteration

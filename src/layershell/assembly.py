@@ -44,7 +44,8 @@ def build_blocks(model: Model, dm: DofMap, elements: np.ndarray | None = None) -
         for k in stack:
             ly = model.layers[k]
             ref = layer_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
-                              ly.angle, ly.direction, max(model.n_thickness, ly.directors))
+                              ly.angle, ly.direction, max(model.n_thickness, ly.directors),
+                              element=getattr(model, "element", "mitc"))
             blocks.append(Block(k, el, dm.element_dofs(model, k, el), ref))
     return blocks
 

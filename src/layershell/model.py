@@ -127,6 +127,7 @@ class Model:
     edge_loads: list[EdgeLoad] = field(default_factory=list)
     n_thickness: int = 3
     nonlinear: bool = True
+    element: str = "mitc"  # "mitc": MITC9 assumed strain (element/mitc.py); "full": fully integrated
     units: str = ""
     # delamination (MODEL.md §9-§10), keyed by the index of the layer above the interface
     interface_laws: dict = field(default_factory=dict)  # int -> InterfaceLaw

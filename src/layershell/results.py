@@ -124,7 +124,13 @@ def evaluate_points(
         X[sel] = sp.X0[:, 0] + th1[:, None] * sp.A3[:, 0]
         Hg = np.einsum("sai,saJ->siJ", U, g)
         F = np.eye(3) + Hg if model.nonlinear else np.broadcast_to(np.eye(3), Hg.shape)
-        Ev = green_lagrange(Hg, model.nonlinear)
+        if getattr(model, "element", "full") == "mitc":  # the element's own (tied) strain field
+            from .element.mitc import tied_strain
+
+            Ev = tied_strain(model.mesh.nodes[conn], model.offset(k)[conn], ly.thickness[conn], ly.directors, U,
+                             xi[sel], eta[sel], thL, model.nonlinear)
+        else:
+            Ev = green_lagrange(Hg, model.nonlinear)
         M = material_frame(sp, ly.angle, ly.direction)[:, 0]
         C = rotate_stiffness(ly.material.stiffness(), M)
         S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))

@@ -106,12 +106,24 @@ def layer_block(
     direction=None,
     n_thickness: int = 3,
     n_inplane: int = 3,
-) -> LayerBlock:
+    element: str = "full",
+):
     """Precompute one layer for elements with nodal coordinates ``X (e, 9, 3)``.
 
     ``H_below (e, 9)`` is the nodal offset Σ_{K<L} H_K of the layer's bottom face from the
     reference surface, ``H (e, 9)`` the nodal layer thickness (2.214), (3.6).
+    ``element``: "full" (fully integrated, this module) or "mitc" (assumed strain,
+    :mod:`.mitc`; returns a :class:`~.mitc.MitcBlock` and uses at least d + 1 thickness points,
+    with fewer the (Θ_L)^d director of d ≥ 3 has zero-energy modes once the shear is tied).
     """
+    if element == "mitc":
+        from .mitc import mitc_block
+
+        if n_inplane != 3:
+            raise ValueError("the MITC9 element needs the 3 x 3 in-plane rule")
+        return mitc_block(X, H_below, H, d, material, angle_deg, direction, max(n_thickness, d + 1))
+    if element != "full":
+        raise ValueError(f"element: unknown element {element!r} (use 'mitc' or 'full')")
     pts, w2 = gauss_2d(n_inplane)
     zeta, wz = gauss_1d(n_thickness)
     sp = surface_points(X, pts[:, 0], pts[:, 1])
@@ -187,6 +199,10 @@ def layer_response_reference(
 
     Kept as the independent second computation the fast kernel is tested against.
     """
+    if not isinstance(block, LayerBlock):  # MITC9 block
+        from .mitc import mitc_response_reference
+
+        return mitc_response_reference(block, U, nonlinear, tangent, sl)
     g, dV, C = block.gradphi[sl], block.dV[sl], block.C[sl]
     Hgrad = np.einsum("eai,eqaJ->eqiJ", U, g)
     F = _I3 + Hgrad if nonlinear else np.broadcast_to(_I3, Hgrad.shape)
@@ -310,8 +326,12 @@ def layer_response(
 
     ``U (e, a, 3)`` are the element's nodal director vectors; ``sl`` restricts to an
     element range (for chunked assembly). Same results as :func:`layer_response_reference`
-    to round-off.
+    to round-off. A :class:`~.mitc.MitcBlock` is evaluated by :func:`.mitc.mitc_response`.
     """
+    if not isinstance(block, LayerBlock):
+        from .mitc import mitc_response
+
+        return mitc_response(block, U, nonlinear, tangent, sl)
     g, dV, C = (np.ascontiguousarray(x[sl], dtype=np.float64) for x in (block.gradphi, block.dV, block.C))
     L = np.ascontiguousarray(block.L[sl]) if block.L is not None else None
     U = np.ascontiguousarray(U, dtype=np.float64)

@@ -768,7 +768,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              "add a stack without 'where' and 'set' (it takes the remaining elements) or widen "
                              "the selections")
     model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
-                  nonlinear=mf.model.nonlinear, units=mf.model.units)
+                  nonlinear=mf.model.nonlinear, units=mf.model.units, element=mf.model.element)
     try:
         model.below()
     except ValueError as exc:

@@ -1,0 +1,451 @@
+"""Assumed-strain (MITC9) layer kernel: tied covariant Green-Lagrange strains at every Θ³ level.
+
+Within one layer the multi-director shell is a 3D continuum with the tensor-product basis
+``phi_(n,l) = N_n(Θ¹,Θ²) (Θ_L³)^l`` (thesis (3.13)); the mixed interpolation of tensorial
+components of Bucalem & Bathe (1993, "Higher-order MITC general shell elements", IJNME 36) acts on
+its covariant Green-Lagrange components E_ij = ½(g_i·g_j − G_i·G_j), g_i = G_i + ∂_i u, at each
+thickness integration point (same natural Θ³ level ζ, same in-plane tying points in every
+level):
+
+* E_11, E_13 tied at r = ±a, s ∈ {−b, 0, b}; interpolated linearly in r, quadratically in s
+* E_22, E_23 tied at r ∈ {−b, 0, b}, s = ±a (the same with r, s swapped)
+* E_12 tied at r, s = ±a, bilinear
+* E_33 taken at the Gauss point itself (the multi-director thickness strain is not tied)
+
+with a = 1/√3, b = √(3/5). The tied covariant strain Ẽ at the 3 × 3 Gauss points is mapped to
+the Cartesian strain of the material law by the contravariant base vectors there,
+E_IJ = (G^i)_I Ẽ_ij (G^j)_J; equivalently the kernel works with the covariant stiffness
+C̃ = Tᵀ C T dV (T the Voigt form of that map), so that with S̃ = C̃ Ẽ
+
+* f_ak = Σ_q Σ_c S̃_c ∂Ẽ_c/∂U_ak,    ∂E_ij/∂U_ak = ½(g_ik ∂_j phi_a + g_jk ∂_i phi_a)
+* K = Σ_q B̃ᵀ C̃ B̃ + δ_kl Σ_p ∂_i phi_a σ_ij(p) ∂_j phi_b,  σ_c(p) = Σ_q h_c(q, p) S̃_c(q)
+
+(the geometric part from the exact second derivatives of the tied strains; h_c the tying
+functions). The total-Lagrangian form of the full element (``kernel.py``) is the special case
+"every component sampled at the Gauss point"; :func:`tying` with ``full=True`` gives it (test).
+
+The components are taken in a frame F_b (:func:`strain_frames`): by default the centre frame
+transported to each point (so that the membrane patch test is exact on straight-edged distorted
+elements), or the natural convected basis G_i of the original MITC9 (``frame="natural"``); the
+formulas above hold with G_i → F_b and ∂_i → the derivative along F_b. At least d + 1 thickness
+points are used. :func:`tied_strain` gives the same tied strain at any point (probes, profiles,
+delamination criterion via ``results.evaluate_points``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from ..material import Orthotropic, rotate_stiffness
+from .geometry import shell_basis, surface_points
+from .quadrature import gauss_1d, gauss_2d
+
+A_TIE = 1.0 / np.sqrt(3.0)
+B_TIE = np.sqrt(0.6)
+_PAIRS = ((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))  # Voigt order 11, 22, 33, 23, 13, 12
+
+
+def _lagrange(nodes: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """1D Lagrange polynomials through ``nodes`` at ``x``: ``(len(x), len(nodes))``."""
+    L = np.ones((len(x), len(nodes)))
+    for j, xj in enumerate(nodes):
+        for k, xk in enumerate(nodes):
+            if k != j:
+                L[:, j] *= (x - xk) / (xj - xk)
+    return L
+
+
+@dataclass(frozen=True)
+class Tying:
+    """Sampling points and tying functions (constant for all elements).
+
+    points (P, 2): in-plane sampling points (the tying points, then the 3 × 3 Gauss points)
+    pts (6, T) int: point index of tie t of Voigt component c (padded), n (6,): ties per component
+    w (6, 9, T): weight of tie t of component c at Gauss point q (Ẽ_c(q) = Σ_t w E_c(pts[c, t]))
+    dirs (P, 3) int, ndir (P,): the directions K with non-zero rows of the tied stress at point p
+    """
+
+    points: np.ndarray
+    pts: np.ndarray
+    n: np.ndarray
+    w: np.ndarray
+    dirs: np.ndarray
+    ndir: np.ndarray
+
+    def dense(self) -> np.ndarray:
+        """H (6, 9, P): Ẽ_c(q) = Σ_p H[c, q, p] E_c(p)."""
+        H = np.zeros((6, 9, len(self.points)))
+        for c in range(6):
+            for t in range(self.n[c]):
+                H[c, :, self.pts[c, t]] += self.w[c, :, t]
+        return H
+
+
+@lru_cache(maxsize=None)
+def tying(full: bool = False) -> Tying:
+    """MITC9 tying of Bucalem & Bathe (1993); ``full=True``: all components at the Gauss points
+    (reproduces the fully integrated element, used as a check)."""
+    gp, _ = gauss_2d(3)
+    a, b = A_TIE, B_TIE
+    la, lb = np.array([-a, a]), np.array([-b, 0.0, b])
+    if full:
+        sets = {c: (gp, np.eye(9)) for c in range(6)}
+        points = gp
+        index = {c: np.arange(9) for c in range(6)}
+    else:
+        PA = np.array([(r, s) for r in la for s in lb])  # E_11, E_13
+        PB = np.array([(r, s) for r in lb for s in la])  # E_22, E_23
+        PC = np.array([(r, s) for r in la for s in la])  # E_12
+        hA = np.einsum("qi,qj->qij", _lagrange(la, gp[:, 0]), _lagrange(lb, gp[:, 1])).reshape(9, 6)
+        hB = np.einsum("qi,qj->qij", _lagrange(lb, gp[:, 0]), _lagrange(la, gp[:, 1])).reshape(9, 6)
+        hC = np.einsum("qi,qj->qij", _lagrange(la, gp[:, 0]), _lagrange(la, gp[:, 1])).reshape(9, 4)
+        points = np.concatenate([PA, PB, PC, gp])
+        iA, iB, iC, iG = np.arange(6), 6 + np.arange(6), 12 + np.arange(4), 16 + np.arange(9)
+        index = {0: iA, 4: iA, 1: iB, 3: iB, 5: iC, 2: iG}
+        sets = {0: (PA, hA), 4: (PA, hA), 1: (PB, hB), 3: (PB, hB), 5: (PC, hC), 2: (gp, np.eye(9))}
+    T = max(len(index[c]) for c in range(6))
+    pts = np.zeros((6, T), np.int64)
+    n = np.zeros(6, np.int64)
+    w = np.zeros((6, 9, T))
+    P = len(points)
+    used = np.zeros((P, 3), bool)
+    for c in range(6):
+        k = len(index[c])
+        pts[c, :k] = index[c]
+        n[c] = k
+        w[c, :, :k] = sets[c][1]
+        i, j = _PAIRS[c]
+        used[index[c], i] = used[index[c], j] = True
+    ndir = used.sum(axis=1).astype(np.int64)
+    dirs = np.zeros((P, 3), np.int64)
+    for p in range(P):
+        dd = np.flatnonzero(used[p])
+        dirs[p, :len(dd)] = dd
+    for x in (points, pts, n, w, dirs, ndir):
+        x.setflags(write=False)
+    return Tying(points, pts, n, w, dirs, ndir)
+
+
+def covariant_map(Ginv: np.ndarray) -> np.ndarray:
+    """T (..., 6, 6): Cartesian Voigt strain (engineering shear) = T · covariant Voigt strain,
+    E_IJ = (G^i)_I E_ij (G^j)_J with ``Ginv`` rows G^i."""
+    T = np.empty(Ginv.shape[:-2] + (6, 6))
+    for c, (i, j) in enumerate(_PAIRS):
+        # unit covariant engineering component c -> tensor E_ij = E_ji = ½ (shear) or 1
+        Gi, Gj = Ginv[..., i, :], Ginv[..., j, :]
+        if i == j:
+            E = np.einsum("...I,...J->...IJ", Gi, Gj)
+        else:
+            E = 0.5 * (np.einsum("...I,...J->...IJ", Gi, Gj) + np.einsum("...I,...J->...IJ", Gj, Gi))
+        for V, (I, J) in enumerate(_PAIRS):
+            T[..., V, c] = E[..., I, J] * (1.0 if I == J else 2.0)
+    return T
+
+
+@dataclass(frozen=True)
+class MitcBlock:
+    """Reference data of one layer over a group of elements for the MITC9 kernel.
+
+    N (P, 9), dN (P, 9, 2): shape functions at the sampling points; thL (e, z, P): Θ_L³ there
+    G (e, z, P, 3, 3): the strain frame vectors F_b (columns) there; M (e, z, P, 3, 3) = G⁻¹F
+    Ct (e, z, 9, 6, 6): covariant stiffness Tᵀ C T dV at the Gauss points; L: its Cholesky factor
+    or None; C (e, z·9, 6, 6), dV (e, z·9): Cartesian stiffness and volume weights (z-major)
+    """
+
+    d: int
+    tie: Tying
+    N: np.ndarray
+    dN: np.ndarray
+    thL: np.ndarray
+    G: np.ndarray
+    M: np.ndarray
+    Ct: np.ndarray
+    L: np.ndarray | None
+    C: np.ndarray
+    dV: np.ndarray
+
+    @property
+    def n_dof(self) -> int:
+        return 27 * (self.d + 1)
+
+
+def _rotation(n0: np.ndarray, n1: np.ndarray) -> np.ndarray:
+    """Smallest rotation taking unit vectors ``n0`` to ``n1`` (..., 3, 3) (Rodrigues)."""
+    v = np.cross(n0, n1)
+    c = np.sum(n0 * n1, axis=-1)
+    Z = np.zeros_like(c)
+    W = np.stack([np.stack([Z, -v[..., 2], v[..., 1]], -1), np.stack([v[..., 2], Z, -v[..., 0]], -1),
+                  np.stack([-v[..., 1], v[..., 0], Z], -1)], -2)
+    return np.eye(3) + W + (W @ W) / (1.0 + c)[..., None, None]
+
+
+def strain_frames(X, H_below, H, points, zeta, frame: str = "center"):
+    """Covariant bases in which strains are tied, at in-plane ``points (P, 2)`` and thickness
+    levels ``zeta``: ``(F, M, G, Ginv, detG, sp, thL)`` with F (e, P, z, 3, 3) the frame vectors
+    F_b as columns and M = G⁻¹F (so that the derivative along F_b is Σ_i M_ib ∂_i).
+
+    ``frame = "natural"``: F = G, the convected base vectors (Bucalem & Bathe 1993).
+    ``frame = "center"``: F_α = R(p) G_α(centre), F_3 = A_3(p), with R(p) the smallest rotation
+    taking the normal at the element centre to the normal at p (same natural level ζ). On a flat
+    element the frame is constant, so a constant strain is tied exactly on any distorted mesh
+    (patch test); on a regular curved element (cylinder) it equals the natural frame. The
+    constant-Jacobian idea of the MITC9i element (Wisniewski & Turska 2018, Comput. Mech. 62).
+    """
+    sp = surface_points(X, points[:, 0], points[:, 1])
+    Hp, Hbp = sp.interpolate(H), sp.interpolate(H_below)  # (e, P)
+    thL = 0.5 * Hp[..., None] * (zeta + 1.0)  # (e, P, z)
+    G, Ginv, detG = shell_basis(sp, Hbp[..., None] + thL)  # (e, P, z, 3, 3)
+    if frame == "natural":
+        F = G
+    elif frame == "center":
+        sc = surface_points(X, np.zeros(1), np.zeros(1))
+        tc = 0.5 * sc.interpolate(H)[..., None] * (zeta + 1.0)
+        Gc, _, _ = shell_basis(sc, sc.interpolate(H_below)[..., None] + tc)  # (e, 1, z, 3, 3)
+        R = _rotation(sc.A3, sp.A3)  # (e, P, 3, 3)
+        Fa = np.einsum("epij,ezja->epzia", R, Gc[:, 0, :, :, :2])
+        F = np.concatenate([Fa, np.broadcast_to(sp.A3[:, :, None, :, None], Fa.shape[:-1] + (1,))], axis=-1)
+    else:
+        raise ValueError(f"unknown strain frame {frame!r}")
+    M = np.einsum("epziJ,epzJb->epzib", Ginv, F)
+    return F, M, G, Ginv, detG, sp, thL
+
+
+def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 0.0, direction=None,
+               n_thickness: int = 3, full: bool = False, frame: str = "center") -> MitcBlock:
+    """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`;
+    ``frame`` see :func:`strain_frames`)."""
+    from .kernel import material_frame
+
+    tie = tying(full)
+    zeta, wz = gauss_1d(n_thickness)
+    gp, w2 = gauss_2d(3)
+    F, M, _, _, _, _, thL = strain_frames(X, H_below, H, tie.points, zeta, frame)  # sampling points
+    Fq, _, _, _, detG, sg, _ = strain_frames(X, H_below, H, gp, zeta, frame)  # Gauss points
+    Hq = sg.interpolate(H)
+    dV = detG * (w2[:, None] * wz[None, :]) * (0.5 * Hq[..., None])  # (e, q, z)
+    mframe = material_frame(sg, angle_deg, direction)
+    C = rotate_stiffness(material.stiffness(), mframe)  # (e, q, 6, 6)
+    T = covariant_map(np.linalg.inv(Fq))  # (e, q, z, 6, 6): rows of F⁻¹ = dual vectors F^i
+    Ct = np.einsum("eqzVc,eqVW,eqzWd->ezqcd", T, C, T) * dV.transpose(0, 2, 1)[..., None, None]
+    Ct = np.ascontiguousarray(0.5 * (Ct + np.swapaxes(Ct, -1, -2)))
+    L = None
+    if np.all(dV > 0):
+        try:
+            L = np.linalg.cholesky(Ct)
+        except np.linalg.LinAlgError:
+            L = None
+    e, q, z = dV.shape
+    Cz = np.ascontiguousarray(np.broadcast_to(C[:, None], (e, z, q, 6, 6)).reshape(e, z * q, 6, 6))
+    N, dN, _ = _quad9(tie.points)
+    return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
+                     np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),
+                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)))
+
+
+def _quad9(points):
+    from .shape import quad9
+
+    return quad9(points[:, 0], points[:, 1])
+
+
+def natural_gradients(block: MitcBlock, sl: slice = slice(None)) -> np.ndarray:
+    """∂_i phi_a at the sampling points, ``(e, z, P, a, 3)`` (i = Θ¹, Θ², Θ³)."""
+    d = block.d
+    l = np.arange(d + 1)
+    t = block.thL[sl][..., None]  # (e, z, P, 1)
+    pw = t ** l
+    dpw = np.where(l > 0, l * t ** np.maximum(l - 1, 0), 0.0)
+    d12 = np.einsum("pna,ezpl->ezpnla", block.dN, pw)
+    d3 = np.einsum("pn,ezpl->ezpnl", block.N, dpw)[..., None]
+    dphi = np.concatenate([d12, d3], axis=-1)
+    e, z, P = dphi.shape[:3]
+    return dphi.reshape(e, z, P, 9 * (d + 1), 3)
+
+
+def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tangent: bool = True,
+                            sl: slice = slice(None)):
+    """Plain NumPy form of the MITC9 layer response (module docstring): ``f (e, m)``, ``K (e, m, m)``."""
+    dphi = np.einsum("ezpai,ezpib->ezpab", natural_gradients(block, sl), block.M[sl])  # along F_b
+    Gc = np.swapaxes(block.G[sl], -1, -2)  # (e, z, P, i, k): G_i components k
+    Ct = block.Ct[sl]
+    H = block.tie.dense()  # (c, q, P)
+    D = np.einsum("ezpai,eak->ezpik", dphi, U)  # ∂_i u
+    g = Gc + D if nonlinear else Gc
+    GD = np.einsum("ezpik,ezpjk->ezpij", Gc, D)
+    E = 0.5 * (GD + np.swapaxes(GD, -1, -2))
+    if nonlinear:
+        E = E + 0.5 * np.einsum("ezpik,ezpjk->ezpij", D, D)
+    Ev = np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in _PAIRS], axis=-1)  # (e, z, P, c)
+    # B (e, z, P, c, a, k) = fac (g_ik dphi_aj + g_jk dphi_ai)
+    B = np.stack([(0.5 if i == j else 1.0) * (np.einsum("ezpk,ezpa->ezpak", g[..., i, :], dphi[..., j])
+                                              + np.einsum("ezpk,ezpa->ezpak", g[..., j, :], dphi[..., i]))
+                  for i, j in _PAIRS], axis=3)
+    Et = np.einsum("cqp,ezpc->ezqc", H, Ev)
+    S = np.einsum("ezqcd,ezqd->ezqc", Ct, Et)
+    Bt = np.einsum("cqp,ezpcak->ezqcak", H, B)
+    e, a = U.shape[:2]
+    m = 3 * a
+    f = np.einsum("ezqcak,ezqc->eak", Bt, S).reshape(e, m)
+    if not tangent:
+        return f, None
+    Bm = Bt.reshape(Bt.shape[:4] + (m,))
+    K = np.einsum("ezqcm,ezqcd,ezqdn->emn", Bm, Ct, Bm, optimize=True)
+    if nonlinear:
+        sv = np.einsum("cqp,ezqc->ezpc", H, S)
+        sig = np.stack([np.stack([sv[..., 0], sv[..., 5], sv[..., 4]], -1),
+                        np.stack([sv[..., 5], sv[..., 1], sv[..., 3]], -1),
+                        np.stack([sv[..., 4], sv[..., 3], sv[..., 2]], -1)], -2)
+        Kg = np.einsum("ezpai,ezpij,ezpbj->eab", dphi, sig, dphi, optimize=True)
+        K = K.reshape(e, a, 3, a, 3) + Kg[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]
+        K = K.reshape(e, m, m)
+    return f, K
+
+
+
+
+_SUB = 8  # elements per sub-block (as in kernel.py)
+
+
+def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int, hi: int) -> None:
+    """Fill ``f[lo:hi]``, ``K[lo:hi]`` (element indices relative to the block slice start ``sl0``)."""
+    from . import _jit
+
+    tie = block.tie
+    d = block.d
+    a = 9 * (d + 1)
+    m = 3 * a
+    nz = block.thL.shape[1]
+    ncol = nz * int(tie.ndir.sum())
+    geo = tangent and nonlinear
+    for s in range(lo, hi, _SUB):
+        t = min(s + _SUB, hi)
+        nb = t - s
+        g0, g1 = sl0 + s, sl0 + t
+        X = np.empty((nb, nz * 9, 6, m) if tangent else (0, 0, 0, 0))
+        GS = np.empty((nb, a, ncol) if geo else (0, 0, 0))
+        GT = np.empty_like(GS)
+        Ct = block.Ct[g0:g1]
+        Lf = block.L[g0:g1] if block.L is not None else Ct
+        _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
+                        tie.ndir, Ct, Lf, U[s:t], d, nonlinear, tangent, geo, block.L is not None, f[s:t], X, GS, GT)
+        if not tangent:
+            continue
+        Xr = X.reshape(nb, 6 * nz * 9, m)
+        if block.L is not None:
+            np.matmul(Xr.transpose(0, 2, 1), Xr, out=K[s:t])
+        else:  # C̃ not positive definite: K = B̃ᵀ (C̃ B̃), B̃ from the identity map
+            B = np.empty_like(X)
+            eye = np.ascontiguousarray(np.broadcast_to(np.eye(6), Ct.shape))
+            _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.n, tie.w, tie.dirs,
+                            tie.ndir, Ct, eye, U[s:t], d, nonlinear, True, False, False, np.empty((nb, m)), B, GS, GT)
+            np.matmul(B.reshape(nb, 6 * nz * 9, m).transpose(0, 2, 1), Xr, out=K[s:t])
+        if geo:
+            _jit.add_geometric(K[s:t], np.matmul(GS, GT.transpose(0, 2, 1)))
+
+
+def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tangent: bool = True,
+                  sl: slice = slice(None)):
+    """Internal force ``(e, m)`` and tangent ``(e, m, m)`` of a MITC9 layer block (compiled point
+    work, one BLAS syrk per element for the material part, elements over threads as in
+    :func:`kernel.layer_response`); equal to :func:`mitc_response_reference` to round-off."""
+    from .kernel import _blas_single_thread, _pool, kernel_threads
+    from contextlib import nullcontext
+
+    n_all = block.thL.shape[0]
+    lo0, hi0, step = sl.indices(n_all)
+    if step != 1:
+        raise ValueError("mitc_response: the element range must be contiguous")
+    U = np.ascontiguousarray(U, dtype=np.float64)
+    nonlinear, tangent = bool(nonlinear), bool(tangent)
+    e = hi0 - lo0
+    a = 9 * (block.d + 1)
+    m = 3 * a
+    f = np.empty((e, m))
+    K = np.empty((e, m, m)) if tangent else None
+    n_threads = min(kernel_threads(), max(1, e // _SUB))
+    with _blas_single_thread() if tangent else nullcontext():
+        if n_threads == 1:
+            _mitc_range(block, lo0, U, nonlinear, tangent, f, K, 0, e)
+        else:
+            bounds = np.linspace(0, e, n_threads + 1).astype(int)
+            jobs = [_pool(n_threads).submit(_mitc_range, block, lo0, U, nonlinear, tangent, f, K, lo, hi)
+                    for lo, hi in zip(bounds[:-1], bounds[1:])]
+            for j in jobs:
+                j.result()
+    return f, K
+
+
+def tying_functions(xi: np.ndarray, eta: np.ndarray) -> list[np.ndarray]:
+    """MITC9 tying functions at arbitrary points: per Voigt component c the weights
+    ``(s, n_c)`` of its ties (E_33: none, it is taken at the point itself)."""
+    a, b = A_TIE, B_TIE
+    la, lb = np.array([-a, a]), np.array([-b, 0.0, b])
+    s = len(xi)
+    hA = np.einsum("qi,qj->qij", _lagrange(la, xi), _lagrange(lb, eta)).reshape(s, 6)
+    hB = np.einsum("qi,qj->qij", _lagrange(lb, xi), _lagrange(la, eta)).reshape(s, 6)
+    hC = np.einsum("qi,qj->qij", _lagrange(la, xi), _lagrange(la, eta)).reshape(s, 4)
+    return [hA, hB, None, hB, hA, hC]
+
+
+def tied_strain(X: np.ndarray, H_below: np.ndarray, H: np.ndarray, d: int, U: np.ndarray, xi: np.ndarray,
+                eta: np.ndarray, thL: np.ndarray, nonlinear: bool = True, frame: str = "center") -> np.ndarray:
+    """Cartesian Voigt Green-Lagrange strain (engineering shear) of the MITC9 element at points
+    ``(xi, eta, Θ_L)`` of elements ``X (s, 9, 3)`` with nodal vectors ``U (s, a, 3)``: the strain
+    the element's stress is computed from (tied E_11, E_22, E_12, E_13, E_23 interpolated from the
+    tying points at the point's natural thickness level, E_33 at the point), so probes, profiles
+    and the delamination criterion see the element's own strain field."""
+    tie = tying()
+    s = len(xi)
+    zeta = (2.0 * thL / np.einsum("sn,sn->s", _quad9(np.stack([xi, eta], -1))[0], H) - 1.0)[:, None, None]
+    pts = np.concatenate([tie.points[:16], np.zeros((1, 2))])  # ties + the point itself (per element)
+    Ffr, M, _, _, _, _, thp = strain_frames(X, H_below, H, pts, zeta, frame)  # (s, 17, 1, ...)
+    # the point itself: evaluate per element at its (xi, eta)
+    Fp, Mp, _, _, _, _, thq = _point_frames(X, H_below, H, xi, eta, zeta, frame)
+    F = np.concatenate([Ffr[:, :16, 0], Fp], axis=1)  # (s, 17, 3, 3)
+    Mm = np.concatenate([M[:, :16, 0], Mp], axis=1)
+    th = np.concatenate([thp[:, :16, 0], thq], axis=1)  # (s, 17)
+    N, dN, _ = _quad9(tie.points[:16])
+    Nq, dNq, _ = _quad9(np.stack([xi, eta], -1))
+    l = np.arange(d + 1)
+    pw, dpw = th[..., None] ** l, np.where(l > 0, l * th[..., None] ** np.maximum(l - 1, 0), 0.0)
+    dNall = np.concatenate([np.broadcast_to(dN, (s,) + dN.shape), dNq[:, None]], axis=1)  # (s, 17, 9, 2)
+    Nall = np.concatenate([np.broadcast_to(N, (s,) + N.shape), Nq[:, None]], axis=1)
+    d12 = np.einsum("spna,spl->spnla", dNall, pw)
+    d3 = np.einsum("spn,spl->spnl", Nall, dpw)[..., None]
+    dphi = np.concatenate([d12, d3], -1).reshape(s, 17, 9 * (d + 1), 3)
+    dphi = np.einsum("spai,spib->spab", dphi, Mm)
+    Gc = np.swapaxes(F, -1, -2)
+    D = np.einsum("spai,sak->spik", dphi, U)
+    GD = np.einsum("spik,spjk->spij", Gc, D)
+    E = 0.5 * (GD + np.swapaxes(GD, -1, -2))
+    if nonlinear:
+        E = E + 0.5 * np.einsum("spik,spjk->spij", D, D)
+    Ev = np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in _PAIRS], axis=-1)  # (s, 17, 6)
+    h = tying_functions(xi, eta)
+    idx = {0: slice(0, 6), 4: slice(0, 6), 1: slice(6, 12), 3: slice(6, 12), 5: slice(12, 16)}
+    Et = np.empty((s, 6))
+    for c in range(6):
+        Et[:, c] = Ev[:, 16, c] if c == 2 else np.einsum("st,st->s", h[c], Ev[:, idx[c], c])
+    T = covariant_map(np.linalg.inv(F[:, 16]))
+    return np.einsum("sVc,sc->sV", T, Et)
+
+
+def _point_frames(X, H_below, H, xi, eta, zeta, frame):
+    """:func:`strain_frames` at one point per element ``(xi[s], eta[s])`` (level ``zeta (s,1,1)``)."""
+    sp = surface_points(X, xi[:, None], eta[:, None], per_element=True)
+    Hp, Hbp = sp.interpolate(H), sp.interpolate(H_below)  # (s, 1)
+    thL = 0.5 * Hp[..., None] * (zeta + 1.0)  # (s, 1, 1)
+    G, Ginv, _ = shell_basis(sp, Hbp[..., None] + thL)
+    if frame == "natural":
+        F = G
+    else:
+        sc = surface_points(X, np.zeros(1), np.zeros(1))
+        tc = 0.5 * sc.interpolate(H)[..., None] * (zeta + 1.0)
+        Gcen, _, _ = shell_basis(sc, sc.interpolate(H_below)[..., None] + tc)
+        R = _rotation(sc.A3, sp.A3)
+        Fa = np.einsum("epij,ezja->epzia", R, Gcen[:, 0, :, :, :2])
+        F = np.concatenate([Fa, np.broadcast_to(sp.A3[:, :, None, :, None], Fa.shape[:-1] + (1,))], axis=-1)
+    M = np.einsum("epziJ,epzJb->epzib", Ginv, F)
+    return F[:, :, 0], M[:, :, 0], None, None, None, None, thL[:, :, 0]

@@ -1,0 +1,302 @@
+"""MITC9 assumed-strain element (issue 14): kernel checks, rank, patch tests, thin-shell benchmarks."""
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from conftest import curved_element, flat_distorted_element
+
+from layershell.element.kernel import layer_block, layer_response, layer_response_reference
+from layershell.element.mitc import mitc_block, mitc_response_reference, tying
+from layershell.material import Orthotropic
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "examples"))
+import shell_benchmarks as sb  # noqa: E402
+
+ORTHO = Orthotropic(100.0, 50.0, 30.0, 20.0, 15.0, 10.0, 0.25, 0.3, 0.1)
+
+
+def _layer(rng, n=1):
+    H = np.full((n, 9), 0.2) + 0.02 * rng.standard_normal((n, 9))
+    return np.full((n, 9), 0.1), H
+
+
+def _rel(a, b):
+    return np.abs(a - b).max() / np.abs(b).max()
+
+
+@pytest.mark.parametrize("d", [0, 1, 2, 3, 4])
+def test_every_component_at_the_gauss_points_is_the_full_element(rng, d):
+    """With all strain components "tied" at the Gauss points themselves, the covariant detour
+    (frame, tying operator, covariant stiffness Tᵀ C T) must give the fully integrated element of
+    kernel.py exactly: an independent check of the frame algebra and of f and K."""
+    X = curved_element(rng)
+    Hb, H = _layer(rng)
+    U = 0.05 * rng.standard_normal((1, 9 * (d + 1), 3))
+    nz = max(3, d)
+    ref = layer_block(X, Hb, H, d, ORTHO, 20.0, n_thickness=nz, element="full")
+    for frame in ("natural", "center"):
+        blk = mitc_block(X, Hb, H, d, ORTHO, 20.0, n_thickness=nz, full=True, frame=frame)
+        for nonlinear in (True, False):
+            f0, K0 = layer_response_reference(ref, U, nonlinear)
+            f1, K1 = mitc_response_reference(blk, U, nonlinear)
+            assert _rel(f1, f0) < 1e-12 and _rel(K1, K0) < 1e-12
+
+
+def test_tying_functions_interpolate_the_tying_points():
+    """The MITC9 tying functions are Lagrange interpolants: a strain field of the assumed form
+    (linear in r × quadratic in s for E_11, E_13; swapped for E_22, E_23; bilinear for E_12) is
+    reproduced exactly at the Gauss points."""
+    t = tying()
+    gp = t.points[16:]
+    fields = {0: lambda r, s: 1 + 2 * r + 3 * s + 4 * r * s * s - s * s,
+              1: lambda r, s: 1 - r + 2 * s + 5 * r * r * s + r * r,
+              5: lambda r, s: 2 + r - s + 3 * r * s}
+    fields[4], fields[3], fields[2] = fields[0], fields[1], lambda r, s: r ** 2 * s ** 2
+    H = t.dense()
+    for c, fn in fields.items():
+        vals = fn(t.points[:, 0], t.points[:, 1])
+        assert np.allclose(H[c] @ vals, fn(gp[:, 0], gp[:, 1]), atol=1e-13)
+
+
+@pytest.mark.parametrize("d", [0, 1, 2, 3, 4])
+def test_tangent_matches_finite_differences(rng, d):
+    """Consistent tangent of the tied strains (material + geometric part from the second
+    derivatives of the tied covariant strains) = central FD of the internal force, nonlinear,
+    on a distorted curved element at a large displacement."""
+    X = curved_element(rng, distort=0.15)
+    Hb, H = _layer(rng)
+    blk = layer_block(X, Hb, H, d, ORTHO, 20.0, element="mitc")
+    U = 0.08 * rng.standard_normal((1, 9 * (d + 1), 3))
+    _, K = layer_response(blk, U)
+    h, m = 1e-6, U.size
+    Kfd = np.zeros((m, m))
+    for j in range(m):
+        Up, Um = U.copy().reshape(-1), U.copy().reshape(-1)
+        Up[j] += h
+        Um[j] -= h
+        Kfd[:, j] = (layer_response(blk, Up.reshape(U.shape), tangent=False)[0]
+                     - layer_response(blk, Um.reshape(U.shape), tangent=False)[0])[0] / (2 * h)
+    assert _rel(K[0], Kfd) < 1e-7
+    assert _rel(K[0], K[0].T) < 1e-13
+
+
+@pytest.mark.parametrize("d", [0, 1, 2, 3, 4])
+@pytest.mark.parametrize("nonlinear", [True, False])
+def test_fast_kernel_equals_reference(rng, d, nonlinear):
+    """Compiled MITC9 kernel = NumPy form (f, K) over many elements and on an element range."""
+    n = 19
+    X = np.concatenate([curved_element(rng) for _ in range(n)])
+    Hb, H = _layer(rng, n)
+    blk = layer_block(X, Hb, H, d, ORTHO, 20.0, element="mitc")
+    U = 0.05 * rng.standard_normal((n, 9 * (d + 1), 3))
+    f0, K0 = layer_response_reference(blk, U, nonlinear)
+    f1, K1 = layer_response(blk, U, nonlinear)
+    assert _rel(f1, f0) < 1e-12 and _rel(K1, K0) < 1e-12
+    f2, K2 = layer_response(blk, U[4:13], nonlinear, sl=slice(4, 13))
+    assert _rel(f2, f0[4:13]) < 1e-12 and _rel(K2, K0[4:13]) < 1e-12
+
+
+def test_fast_kernel_without_factor(rng):
+    """C̃ not positive definite (a negative volume weight): the general product path."""
+    import dataclasses
+
+    X = np.concatenate([curved_element(rng) for _ in range(3)])
+    Hb, H = _layer(rng, 3)
+    blk = layer_block(X, Hb, H, 2, ORTHO, 20.0, element="mitc")
+    blk = dataclasses.replace(blk, L=None)
+    U = 0.05 * rng.standard_normal((3, 27, 3))
+    f0, K0 = layer_response_reference(blk, U)
+    f1, K1 = layer_response(blk, U)
+    assert _rel(f1, f0) < 1e-12 and _rel(K1, K0) < 1e-12
+
+
+def _scaled_stiffness(X, d, H0=1.0, element="mitc"):
+    H = np.full((1, 9), H0)
+    blk = layer_block(X, -H / 2, H, d, ORTHO, 20.0, element=element)
+    _, K = layer_response(blk, np.zeros((1, 9 * (d + 1), 3)), nonlinear=False)
+    s = 1 / np.sqrt(np.diag(K[0]))
+    return K[0] * s[:, None] * s[None]  # Jacobi scaling: the (Θ_L)^l directors have small entries
+
+
+@pytest.mark.parametrize("d", [1, 2, 3, 4])
+@pytest.mark.parametrize("shape", ["flat", "flat_distorted"])
+def test_free_flat_element_has_exactly_six_zero_eigenvalues(rng, d, shape):
+    """Rank: a free flat element (regular or distorted) has exactly the 6 rigid-body zero modes;
+    the 7th eigenvalue is far from round-off (no spurious modes). With only d thickness points
+    the (Θ_L)^d director of d ≥ 3 would add 6 zero modes once E_α3 is tied — hence d + 1 points."""
+    X = flat_distorted_element(rng, 0.0 if shape == "flat" else 0.15)
+    for H0 in (0.2, 1.0):
+        ev = np.linalg.eigvalsh(_scaled_stiffness(X, d, H0))
+        ev = ev / ev.max()
+        assert np.all(np.abs(ev[:6]) < 1e-12)
+        assert ev[6] > 1e-9
+
+
+@pytest.mark.parametrize("d", [1, 2, 3, 4])
+def test_free_curved_element_has_no_spurious_modes(rng, d):
+    """A curved element's rigid rotations are only approximately strain-free (the normal A_3 is
+    not in the span of the nodal basis; the same in the full element), so: 3 exact translations,
+    and after removing the 6 softest modes of the full element, the MITC9 stiffness is as far
+    from singular as the full element's (ratio of the smallest eigenvalues > 1e-2)."""
+    X = curved_element(rng, distort=0.15)
+    Km, Kf = _scaled_stiffness(X, d), _scaled_stiffness(X, d, element="full")
+    ev = np.linalg.eigvalsh(Km) / np.abs(Km).max()
+    assert np.sum(np.abs(ev) < 1e-12) == 3
+    w, V = np.linalg.eigh(Kf)
+    P = V[:, 6:]  # complement of the 6 (near) rigid modes
+    lm = np.linalg.eigvalsh(P.T @ Km @ P)[0]
+    lf = np.linalg.eigvalsh(P.T @ Kf @ P)[0]
+    assert lm > 1e-2 * lf
+
+
+# ----------------------------------------------------------------------------- thin-shell benchmarks
+def test_scordelis_lo_4x4():
+    """Scordelis-Lo roof, quarter model 4 × 4 (d = 2): within 3 % of 0.3024 (full element: −17 %)."""
+    w = sb.scordelis_lo(4, "mitc", 2)
+    assert abs(w / sb.SCORDELIS_REF - 1) < 0.03
+
+
+def test_pinched_cylinder_8x8():
+    """Pinched cylinder octant 8 × 8 (d = 2): within 5 % of 1.8248e-5 (full element: −45 %)."""
+    w = sb.pinched_cylinder(8, "mitc", 2)
+    assert abs(w / sb.PINCHED_REF - 1) < 0.05
+
+
+# ----------------------------------------------------------------------------- patch tests
+def _patch_models():
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import test_patch
+
+    return test_patch
+
+
+def _bending_tip_distorted(rng, d, nu, element="mitc", E=1e5, M=100.0):
+    """Pure bending (linear end traction, moment M per width) of a plate strip 10 × 1 × 1 on a
+    straight-edged distorted 5 × 2 mesh, symmetry plane at x = 0: deflection difference between
+    the corners (10, 0) and (0, 0) at mid-depth; exact 3D value M l²/(2EI) (quadratic field)."""
+    from layershell.element.shape import NODE_XI
+    from layershell.model import EdgeLoad, Fix, Layer, Model, Symmetry
+    from layershell.results import evaluate_points
+    from layershell.solver.newton import load_steps
+    from layershell.solver.problem import Problem
+
+    tp = _patch_models()
+    m = tp._distorted_plate(rng, 10.0, 1.0, 5, 2, straight=True)
+    x = m.nodes
+    ly = Layer("b", Orthotropic.isotropic(E, nu), d, np.ones(m.n_nodes))
+    x0 = np.flatnonzero(np.isclose(x[:, 0], 0))
+    n0 = np.flatnonzero(np.isclose(x[:, 0], 0) & np.isclose(x[:, 1], 0))
+    model = Model(m, [ly], [(0,)], np.zeros(m.n_elements, int), fixes=[Fix(n0, 0, (0,), (1, 2))],
+                  symmetries=[Symmetry(x0, np.array([1.0, 0, 0]))],
+                  edge_loads=[EdgeLoad(tp._edges(m, np.isclose(x[:, 0], 10.0)), np.array([1.0, 0, 0]),
+                                       lambda theta3, **kw: 12 * M * (theta3 - 0.5))],
+                  nonlinear=False, element=element)
+    pb = Problem.build(model)
+    st = list(load_steps(pb, np.array([1.0])))[-1]
+    out = []
+    for corner in ([10.0, 0.0], [0.0, 0.0]):
+        node = int(np.argmin(np.linalg.norm(x[:, :2] - corner, axis=1)))
+        el, loc = np.argwhere(m.elements == node)[0]
+        ps = evaluate_points(model, pb.dm, st.u, [el], NODE_XI[loc, 0], NODE_XI[loc, 1], [0.5])
+        out.append(ps.u[0, 2])
+    return abs(out[0] - out[1])
+
+
+@pytest.mark.parametrize("d", [2, 3])
+def test_bending_patch_on_distorted_mesh_is_exact(rng, d):
+    """Bending patch test (ν = 0.4) on a straight-edged distorted mesh: exact to round-off."""
+    w = _bending_tip_distorted(rng, d, 0.4)
+    assert np.isclose(w, 100.0 * 100 / (2 * 1e5 / 12), rtol=1e-9)
+
+
+def test_centre_frame_passes_the_membrane_patch_test_natural_frame_does_not(rng, monkeypatch):
+    """Why the strains are tied in the rotated centre frame: on a straight-edged distorted mesh
+    a constant stress state is exact with it (the frame is constant on a flat element), while the
+    natural convected frame of the original MITC9 (Bucalem & Bathe 1993) misses it (≈ 3e-5)."""
+    from functools import partial
+
+    from layershell.element import mitc
+    from layershell.model import EdgeLoad, Fix, Layer, Model, Symmetry
+    from layershell.results import evaluate_points
+    from layershell.solver.newton import load_steps
+    from layershell.solver.problem import Problem
+
+    tp = _patch_models()
+    errors = {}
+    for frame in ("center", "natural"):
+        monkeypatch.setattr(mitc, "mitc_block", partial(mitc_block, frame=frame))
+        m = tp._distorted_plate(np.random.default_rng(3), straight=True)
+        E, nu, H, sig = 1000.0, 0.3, 0.1, 2.0
+        x = m.nodes
+        ly = Layer("p", Orthotropic.isotropic(E, nu), 2, np.full(m.n_nodes, H))
+        x0 = np.flatnonzero(np.isclose(x[:, 0], 0))
+        y0 = np.flatnonzero(np.isclose(x[:, 1], 0))
+        corner = np.flatnonzero(np.isclose(x[:, 0], 2.0) & np.isclose(x[:, 1], 0))
+        model = Model(m, [ly], [(0,)], np.zeros(m.n_elements, int),
+                      fixes=[Fix(x0, 0, (0,), (2,)), Fix(corner, 0, (0,), (2,))],
+                      symmetries=[Symmetry(x0, np.array([1.0, 0, 0])), Symmetry(y0, np.array([0, 1.0, 0]))],
+                      edge_loads=[EdgeLoad(tp._edges(m, np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0]),
+                                           lambda theta3, **kw: sig + 0 * theta3)], nonlinear=False)
+        pb = Problem.build(model)
+        st = list(load_steps(pb, np.array([1.0])))[-1]
+        el = np.repeat(np.arange(m.n_elements), 4)
+        ps = evaluate_points(model, pb.dm, st.u, el, np.tile([-1, 1, 1, -1], m.n_elements),
+                             np.tile([-1, -1, 1, 1], m.n_elements), 0.05)
+        errors[frame] = np.abs(ps.u[:, 0] - sig * ps.X[:, 0] / E).max() / (2 * sig / E)
+    assert errors["center"] < 1e-10
+    assert errors["natural"] > 1e-6
+
+
+def test_tied_strain_at_points_equals_the_kernel_strain(rng):
+    """tied_strain (used by probes, profiles and the delamination criterion) at the Gauss points
+    and thickness levels of the kernel = the kernel's tied strain there (from its stress: C̃⁻¹ S̃
+    per point, then to Cartesian axes): one strain field for the stiffness and the output."""
+    from layershell.element import mitc
+    from layershell.element.quadrature import gauss_1d, gauss_2d
+
+    d, nz = 2, 3
+    X = curved_element(rng, distort=0.15)
+    Hb, H = _layer(rng)
+    U = 0.05 * rng.standard_normal((1, 9 * (d + 1), 3))
+    blk = mitc_block(X, Hb, H, d, ORTHO, 20.0, n_thickness=nz)
+    # kernel's tied covariant strain at (z, q): from its internal algebra (reference form)
+    dphi = np.einsum("ezpai,ezpib->ezpab", mitc.natural_gradients(blk), blk.M)
+    Gc = np.swapaxes(blk.G, -1, -2)
+    D = np.einsum("ezpai,eak->ezpik", dphi, U)
+    GD = np.einsum("ezpik,ezpjk->ezpij", Gc, D)
+    E = 0.5 * (GD + np.swapaxes(GD, -1, -2)) + 0.5 * np.einsum("ezpik,ezpjk->ezpij", D, D)
+    Ev = np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in mitc._PAIRS], axis=-1)
+    Et = np.einsum("cqp,ezpc->ezqc", tying().dense(), Ev)[0]  # (z, q, 6)
+    gp, _ = gauss_2d(3)
+    zeta, _ = gauss_1d(nz)
+    Fq = mitc.strain_frames(X, Hb, H, gp, zeta)[0][0]  # (q, z, 3, 3)
+    want = np.einsum("qzVc,zqc->zqV", mitc.covariant_map(np.linalg.inv(Fq)), Et)
+    Hq = np.einsum("qn,n->q", mitc._quad9(gp)[0], H[0])
+    for z in range(nz):
+        thL = 0.5 * Hq * (zeta[z] + 1)
+        got = mitc.tied_strain(np.repeat(X, 9, 0), np.repeat(Hb, 9, 0), np.repeat(H, 9, 0), d,
+                               np.repeat(U, 9, 0), gp[:, 0].copy(), gp[:, 1].copy(), thL)
+        assert np.allclose(got, want[z], rtol=1e-10, atol=1e-12 * np.abs(want).max())
+
+
+@pytest.mark.slow
+def test_scordelis_lo_8x8_and_the_converged_value():
+    """Scordelis-Lo 8 × 8 (MITC9, d = 2): within 0.2 % of the converged value of the same
+    continuum model, computed independently with the fully integrated element on 24 × 24
+    (0.3061), and 1.1 % above the conventional 0.3024. Both elements converge to 0.3061 (+1.2 %;
+    the deep-shell theory value is 0.3086, +2.0 %): the 1 % target of issue 14 against 0.3024
+    measures this model's converged value, not the element; so 8 × 8 is checked against the
+    converged value, 0.3024 only to 1.5 %."""
+    w8 = sb.scordelis_lo(8, "mitc", 2)
+    w_conv = sb.scordelis_lo(24, "full", 2)
+    assert abs(w8 / w_conv - 1) < 0.002
+    assert abs(w8 / sb.SCORDELIS_REF - 1) < 0.015
+
+
+@pytest.mark.slow
+def test_pinched_cylinder_16x16():
+    """Pinched cylinder octant 16 × 16 (MITC9, d = 2): within 2 % of 1.8248e-5 (+0.6 %; full
+    element −10 %)."""
+    w = sb.pinched_cylinder(16, "mitc", 2)
+    assert abs(w / sb.PINCHED_REF - 1) < 0.02
