@@ -595,7 +595,13 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             dirs = tuple(range(d + 1)) if sd.directors == "all" else tuple(sd.directors)
             if any(l > d or l < 0 for l in dirs):
                 raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dirs)}")
-            model.fixes.append(Fix(nodes, k, dirs, tuple(XYZ.index(c) for c in sd.components)))
+            value = None
+            if sd.value is not None:
+                if len(sd.value) != len(sd.components):
+                    raise InputError(f"'{f}.value': give one prescribed displacement per entry of 'components' "
+                                     f"({len(sd.components)}: {list(sd.components)}), got {len(sd.value)}")
+                value = tuple(float(x) for x in sd.value)
+            model.fixes.append(Fix(nodes, k, dirs, tuple(XYZ.index(c) for c in sd.components), value, sd.scaled))
         elif sd.type == "symmetry":
             model.symmetries.append(Symmetry(nodes, _vec(sd.normal, f + ".normal")))
         else:

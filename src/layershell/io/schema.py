@@ -217,6 +217,11 @@ class FixDef(Strict):
     layer: str | None = Field(None, description="default: the layer at the reference face")
     directors: Union[Literal["all"], list[int]] = [0]
     components: list[Component] = ["x", "y", "z"]
+    value: list[FiniteFloat] | None = Field(
+        None, description="prescribed displacement instead of zero: one value per entry of 'components' (length "
+                          "units; for directors 1.. the director's units), multiplied by the load factor λ when "
+                          "'scaled' (displacement control); the reaction there is f_int − F_ext")
+    scaled: bool = Field(True, description="with 'value': multiplied by the load factor λ (false: constant)")
 
 
 class SymmetryDef(Strict):
