@@ -346,3 +346,56 @@ def test_arc_length_without_a_scaled_load_is_bad_input():
         _spec(DISP_TIP.format(w=1.0), False, 4, ARC_STEPS)
     with pytest.raises(InputError, match="steps.factors"):
         _spec(FORCE_TIP.format(P=0.1), False, 4, ARC_STEPS + "\nfactors = [0.5, 1.0]")
+
+
+def test_adaptive_steps_reach_the_end_in_fewer_steps():
+    """Automatic step size on the large-deflection cantilever (w/l ≈ 0.7): from the same first
+    increment (1/20) it reaches λ = 1 in fewer steps and Newton iterations than 20 fixed steps,
+    with the same answer."""
+    res = {}
+    for key, extra in (("fixed", ""), ("adaptive", "adaptive = true")):
+        r = run(_spec(FORCE_TIP.format(P=0.5), True, 20, extra))
+        assert r.converged
+        st = r.summary["steps"]
+        res[key] = (len(st), sum(s["iterations"] for s in st), r.summary["probes"]["w"], st[-1]["load_factor"])
+    assert res["fixed"][0] == 20
+    assert res["adaptive"][3] == 1.0
+    assert res["adaptive"][0] <= 10 and res["adaptive"][1] < res["fixed"][1]
+    assert res["adaptive"][2] == pytest.approx(res["fixed"][2], rel=1e-9)
+
+
+def test_jump_warnings_unit():
+    from layershell.solver.arclength import jump_warnings
+
+    assert jump_warnings(3, 0.75, 0.5, 0.30, 0.05, None, None, 0.2, 3.0)  # 25 % of the interface at once
+    assert not jump_warnings(3, 0.75, 0.5, 0.20, 0.05, None, None, 0.2, 3.0)
+    # a probe 5× larger while λ grew 1.5× (5 > 3 · 1.5): a jump; 4× while λ grew 2× (4 < 3 · 2): none
+    assert jump_warnings(3, 0.75, 0.5, None, None, {"w": 5.0}, {"w": 1.0}, 0.2, 3.0)
+    assert not jump_warnings(3, 1.0, 0.5, None, None, {"w": 4.0}, {"w": 1.0}, 0.2, 3.0)
+    assert not jump_warnings(3, 0.75, 0.5, None, None, {"w": 4.0}, {"w": 0.0}, 0.2, 3.0)  # from zero: no ratio
+    assert not jump_warnings(3, 0.75, 0.5, 0.9, 0.0, {"w": 40.0}, {"w": 1.0}, None, None)  # switched off
+
+
+@pytest.mark.slow
+def test_debonding_jump_is_warned_and_cut():
+    """§5.1 plate with strong friction, 3 × 3: 4 fixed steps debond 27.8 % of the interface in
+    one step - a warning in summary.json; adaptive steps cut that step (5 halvings, to
+    Δλ = 1/128) and, as the jump stays (the stress criterion releases the zone at once), accept it
+    with the warning at the onset load."""
+    import warnings
+
+    from helpers import run_example
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = run_example("cantilever_plate_strong", {"n = 24": "n = 4"})
+    assert r.converged
+    w = r.summary["warnings"]
+    assert len(w) == 1 and "step 3" in w[0] and "27.8 %" in w[0]
+    assert any("debonded area jumped" in str(c.message) for c in caught)  # on the console too
+    r = run_example("cantilever_plate_strong", {"n = 24": "n = 4\nadaptive = true"})
+    assert r.converged and r.summary["steps"][-1]["load_factor"] == 1.0
+    w = r.summary["warnings"]
+    assert len(w) == 1
+    lam_jump = float(w[0].split("λ = ")[1].split(")")[0])
+    assert 0.5 < lam_jump < 0.5 + 0.25 / 2**4  # cut down near the onset (between 0.5 and 0.75)

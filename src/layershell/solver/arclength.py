@@ -55,10 +55,11 @@ class PathSettings:
     psi: float = 0.0
     dissipation: bool = True
     dissipation_threshold: float = 1e-3
-    target_iterations: int = 6
+    target_iterations: int = 8  # Newton iterations of a 'normal' increment: ×(8/its), within [½, 2]
     max_steps: int = 1000
     end_fraction: float = 1e-3  # arc length: the path ends when λ falls below this fraction of its peak
     max_cuts: int = 12
+    max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
     jump_area: float | None = 0.2
     jump_ratio: float | None = 3.0
 
@@ -344,8 +345,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             cuts += 1
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
-            if cuts > ps.max_cuts or small:
-                if msg in ("debonding jump", "probe jump"):
+            jump = msg in ("debonding jump", "probe jump")
+            if cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts):
+                if jump:
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
                     continue
                 if st.mode == "dissipation":
@@ -369,7 +371,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)
-        fac = min(2.0, max(0.5, math.sqrt(ps.target_iterations / its))) if cuts == 0 else min(1.0, math.sqrt(ps.target_iterations / its))
+        fac = min(2.0, max(0.5, ps.target_iterations / its))
+        if cuts:
+            fac = min(fac, 1.0)  # no growth right after a cut
         if st.mode == "load":
             st.size = min(max(st.size * fac, inc_min), inc_max)
         elif st.mode == "arc":
