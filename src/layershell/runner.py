@@ -348,6 +348,9 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                     summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,
                                                      **rec["debonded_area"]})
                     summary["first_delamination_load_factor"] = ctl.first_failure()
+                if getattr(st, "state", None) is not None:  # arc length / adaptive: the constraint of the step
+                    rec["path"] = {"constraint": st.state.mode, "size": float(st.state.size),
+                                   "dissipation": float(st.dissipation)}
                 jumps.check(st, vals, rec.get("debonded_area"), ctl)
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)

@@ -323,6 +323,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     if not att.converged:
                         ok, msg = False, att.message
                         break
+            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and cuts < 3
+                    and float((att.u - u) @ st.du_prev) < 0.0):
+                ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio):
                     ok, msg = False, "probe jump"
