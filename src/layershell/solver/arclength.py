@@ -8,7 +8,9 @@
   q = Tᵀ F_scaled. Each iteration solves K_r [a, b] = [r, q] with one factorisation (bordering
   by superposition, δu = a + δλ b); δλ is the root of the quadratic constraint closest to the
   previous increment (Crisfield). Predictor sign: the previous increment's direction
-  (sign Δuₚᵣₑᵥ · δu_t > 0; Feng, Perić & Owen 1996), positive on the first step.
+  (sign Δuₚᵣₑᵥ · δu_t > 0; Feng, Perić & Owen 1996); on the first increment and after an
+  increment that changed the state (debonding) the work criterion sign(Δλ) = sign(qᵀδu_t)
+  (load further where the current state is stable under load control, unload where it is not).
 * Dissipation-based control (Gutiérrez 2004, Int. J. Numer. Meth. Engng 59; Verhoosel,
   Remmers & Gutiérrez 2009, Int. J. Numer. Meth. Engng 77): for damage with secant unloading the
   energy dissipated in an increment from (u₀, λ₀) is ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀), linear in the
@@ -76,12 +78,13 @@ class PathState:
     dissipated: float = 0.0  # Σ ΔG of the increments so far
     finished: bool = False
     arc_length0: float = 0.0  # the first arc length (sets the default bounds)
+    changed: bool = False  # the last increment changed the state (debonding): work criterion next
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
                "path.arc_length": np.array(self.arc_length), "path.lam_peak": np.array(self.lam_peak),
                "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
-               "path.arc_length0": np.array(self.arc_length0)}
+               "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed)}
         if self.du_prev is not None:
             out["path.du_prev"] = self.du_prev.copy()
         return out
@@ -93,7 +96,7 @@ class PathState:
         return cls(str(a["path.mode"]), float(a["path.size"]), float(a["path.arc_length"]),
                    np.array(a["path.du_prev"], float) if "path.du_prev" in a else None,
                    float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
-                   float(a["path.arc_length0"]))
+                   float(a["path.arc_length0"]), bool(a["path.changed"]))
 
 
 @dataclass
@@ -154,7 +157,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     dUt = op.expand(dut)
     if mode == "arc":
         dlam = size / math.sqrt(float(dut @ dut) + ps.psi**2 * qq)
-        if du_prev is not None and float(du_prev @ dUt) < 0.0:
+        if (float(du_prev @ dUt) if du_prev is not None else float(q @ dut)) < 0.0:
             dlam = -dlam
     else:
         F = problem.F_scaled
@@ -167,7 +170,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     for it in range(s.max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
-        f, Kr = asm.evaluate_reduced(u, op)
+        f, _ = asm.evaluate(u, tangent=False)  # the tangent only where an iteration follows
         r = op.reduce(problem.external(lam) - f)
         rn = float(np.linalg.norm(r))
         att.residuals.append(rn)
@@ -182,6 +185,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         if it == s.max_iterations:
             break
         try:
+            _, Kr = asm.evaluate_reduced(u, op)
             ab = solver.solve(Kr, np.column_stack([r, q]))
         except linear.SingularSystemError as exc:
             att.message = f"singular tangent ({exc})"
@@ -290,7 +294,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 u_new, res = newton(problem, u, trial, s)
                 att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
             else:
-                att = arc_attempt(problem, u, lam, st.size, st.mode, st.du_prev, s, ps, max(st.lam_peak, abs(lam)))
+                att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
+                                  max(st.lam_peak, abs(lam)))
                 if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
                     u_new, res = newton(problem, u, end, s)
                     if res.converged:
@@ -316,14 +321,14 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         u_new, res = newton(problem, att.u, att.lam, s)
                         att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
                     else:  # the same increment again under the same constraint in the new state
-                        att = arc_attempt(problem, u, lam, st.size, st.mode, st.du_prev, s, ps,
-                                          max(st.lam_peak, abs(lam)))
+                        att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,
+                                          max(st.lam_peak, abs(lam)))  # sign: the work criterion in the new state
                     total_it += att.iterations
                     residuals += att.residuals
                     if not att.converged:
                         ok, msg = False, att.message
                         break
-            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and cuts < 3
+            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float((att.u - u) @ st.du_prev) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
@@ -388,6 +393,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size = st.size * fac
             st.arc_length = max(min(float(np.linalg.norm(du[problem.op.independent])), dl_max), dl_min)
         st.du_prev = du
+        st.changed = resolves > 0
         u, lam = att.u, att.lam
         st.lam_peak = max(st.lam_peak, abs(lam))
         if st.mode == "load":
@@ -399,7 +405,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.finished = True
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
         res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
-                              st.lam_peak, st.dissipated, st.finished, st.arc_length0)
+                              st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed)
         res.warnings = warns
         res.dissipation = dG
         yield res
