@@ -324,7 +324,7 @@ def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
     full = run(spec, tmp_path / "full", write_vtu=False)
     assert full.converged
     lams = [s["load_factor"] for s in full.summary["steps"]]
-    assert lams[-1] == 1.0 and len(lams) >= 3
+    assert lams[-1] == 1.0 and len(lams) >= 3 and full.summary["path_end"] == "lambda_end"
 
     def stop(i, n, lam):
         if i == 2:
@@ -399,3 +399,21 @@ def test_debonding_jump_is_warned_and_cut():
     assert len(w) == 1
     lam_jump = float(w[0].split("λ = ")[1].split(")")[0])
     assert 0.5 < lam_jump < 0.5 + 0.25 / 2**4  # cut down near the onset (between 0.5 and 0.75)
+
+
+def test_displacement_control_restart(tmp_path):
+    """A displacement-controlled run stopped after step 2 and restarted ends where the
+    uninterrupted run ends (the prescribed part of u is imposed again at every load factor)."""
+    spec = _spec(DISP_TIP.format(w=3.0), True, 4)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+
+    def stop(i, n, lam):
+        if i == 2:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged and full.converged
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
+    assert again.summary["probes"]["w"] == pytest.approx(3.0, rel=1e-12)

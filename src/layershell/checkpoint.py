@@ -84,7 +84,7 @@ def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarr
             extra: dict[str, np.ndarray] | None = None) -> Checkpoint:
     """A :class:`Checkpoint` holding copies (later changes of the live state do not reach it)."""
     keep = {k: summary[k] for k in ("steps", "probes", "debonded_area", "first_delamination_load_factor",
-                                    "restarts", "wall_seconds", "warnings") if k in summary}
+                                    "restarts", "wall_seconds", "warnings", "path_end") if k in summary}
     return Checkpoint(int(step), float(load_factor), np.array(u, float, copy=True),
                       np.array(load_factors, float, copy=True), hash_,
                       {k: np.array(v, copy=True) for k, v in (interface_state or {}).items()},

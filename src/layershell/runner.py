@@ -351,6 +351,8 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                 if getattr(st, "state", None) is not None:  # arc length / adaptive: the constraint of the step
                     rec["path"] = {"constraint": st.state.mode, "size": float(st.state.size),
                                    "dissipation": float(st.dissipation)}
+                    if getattr(st, "end", None):
+                        summary["path_end"] = st.end  # lambda_end, complete failure or max_steps
                 jumps.check(st, vals, rec.get("debonded_area"), ctl)
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)

@@ -362,7 +362,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     st.mode, st.size = "arc", st.arc_length
                     cuts = 0
                     continue
-                if st.lam_peak > 0 and abs(lam) <= 1e-3 * st.lam_peak and n > step0 + 1:
+                if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
                 raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
                                        f"cuts ({msg}); the last converged load factor is {lam:.6g}",
@@ -401,13 +401,17 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         else:
             st.finished = (to_end or lam >= end
                            or (st.lam_peak > 0 and dlam < 0 and lam <= ps.end_fraction * st.lam_peak))
-        if n == ps.max_steps:
-            st.finished = True
+        end_reason = None
+        if st.finished:
+            end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
+        elif n == ps.max_steps:
+            st.finished, end_reason = True, "max_steps"
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
         res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
                               st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed)
         res.warnings = warns
         res.dissipation = dG
+        res.end = end_reason  # why the path ends here ("lambda_end", "complete failure", "max_steps"), else None
         yield res
         if st.finished:
             return
