@@ -358,9 +358,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 if jump:
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
                     continue
-                if st.mode == "dissipation":
+                if st.mode == "dissipation":  # once per increment: then the arc length alone
                     st.mode, st.size = "arc", st.arc_length
-                    cuts = 0
+                    cuts, tried_dissipation = 0, True
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
