@@ -90,7 +90,7 @@ def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarr
             extra: dict[str, np.ndarray] | None = None) -> Checkpoint:
     """A :class:`Checkpoint` holding copies (later changes of the live state do not reach it)."""
     keep = {k: summary[k] for k in ("steps", "probes", "debonded_area", "first_delamination_load_factor",
-                                    "restarts", "wall_seconds") if k in summary}
+                                    "restarts", "wall_seconds", "warnings", "path_end") if k in summary}
     return Checkpoint(int(step), float(load_factor), np.array(u, float, copy=True),
                       np.array(load_factors, float, copy=True), hash_,
                       {k: np.array(v, copy=True) for k, v in (interface_state or {}).items()},
@@ -184,6 +184,7 @@ def check_compatible(ck: Checkpoint, spec, n_full: int, where: str | Path) -> No
     if ck.load_factors.shape != lf.shape or not np.array_equal(ck.load_factors, lf):
         raise CheckpointError(f"--restart '{where}': the checkpoint's load factors differ from the model's [steps]; "
                               "rerun without --restart")
-    if ck.u.shape != (n_full,) or not 0 <= ck.step <= lf.size:
+    n_max = lf.size if getattr(spec, "path_following", None) is None else spec.path_following.max_steps
+    if ck.u.shape != (n_full,) or not 0 <= ck.step <= n_max:
         raise CheckpointError(f"--restart '{where}': the checkpoint does not fit this model ({ck.u.size} "
                               f"displacements for {n_full} DOFs, step {ck.step} of {lf.size}); rerun without --restart")

@@ -23,9 +23,15 @@ class ConstraintError(ValueError):
 
 @dataclass(frozen=True)
 class ConstraintOperator:
+    """u_full = T u_red + λ g_scaled + g_const: ``g_*`` are the prescribed displacements
+    (supports with a ``value``) carried to the DOFs that depend on them; None without any."""
+
     T: sp.csr_matrix  # (n_full, n_red)
     independent: np.ndarray  # full DOF index of each reduced DOF
-    fixed: np.ndarray  # full DOFs fixed to zero
+    fixed: np.ndarray  # full DOFs fixed to zero or to a prescribed value
+    g_scaled: np.ndarray | None = None  # (n_full,) prescribed displacement per unit load factor
+    g_const: np.ndarray | None = None  # (n_full,) prescribed displacement independent of λ
+    prescribed: np.ndarray | None = None  # full DOFs with a non-zero prescribed value
 
     @property
     def n_red(self) -> int:
@@ -46,6 +52,7 @@ class _Rows:
         self.cols: list[np.ndarray] = []
         self.vals: list[np.ndarray] = []
         self.fixed: list[np.ndarray] = []
+        self.values: list[tuple[np.ndarray, np.ndarray, bool]] = []  # prescribed (dofs, values, scaled)
         self.srcs: list[np.ndarray] = []
         self.names: list[str] = []
 
@@ -65,6 +72,13 @@ class _Rows:
     def fix(self, dofs):
         d = np.asarray(dofs).ravel()
         self.fixed.append(d[d >= 0])
+
+    def prescribe(self, dofs, values, scaled: bool):
+        """Fix ``dofs`` to ``values`` (× λ when ``scaled``), an inhomogeneous support."""
+        d, v = np.broadcast_arrays(np.asarray(dofs), np.asarray(values, float))
+        keep = d >= 0
+        self.fix(d[keep])
+        self.values.append((d[keep].ravel(), v[keep].ravel(), scaled))
 
     def cat(self, lst, dtype):
         return np.concatenate(lst).astype(dtype) if lst else np.zeros(0, dtype)
@@ -110,7 +124,11 @@ def collect(model: Model, dm: DofMap, bonded: dict[int, np.ndarray] | None = Non
     # --- supports
     for fx in model.fixes:
         D = dm.layer_dofs[fx.layer][fx.nodes]
-        rows.fix(D[:, list(fx.directors)][:, :, list(fx.components)])
+        sel = D[:, list(fx.directors)][:, :, list(fx.components)]
+        if getattr(fx, "value", None) is None:
+            rows.fix(sel)
+        else:  # prescribed displacement (displacement control), value per component
+            rows.prescribe(sel, np.asarray(fx.value, float)[None, None, :], fx.scaled)
     # --- symmetry planes: u_l · n = 0 for every free director vector
     for i, sy in enumerate(model.symmetries):
         src = rows.source(f"symmetry plane {i + 1}")
@@ -205,7 +223,38 @@ def build_operator(n_full: int, rows: _Rows) -> ConstraintOperator:
     else:
         raise ConstraintError("constraints refer to each other in a cycle; check supports, hinges and bonds")
     T.sort_indices()
-    return ConstraintOperator(T, indep, fixed)
+    g_s, g_c, pres = _prescribed(n_full, rows, D)
+    return ConstraintOperator(T, indep, fixed, g_s, g_c, pres)
+
+
+def _prescribed(n_full: int, rows: _Rows, D: sp.csr_matrix):
+    """Prescribed displacement vectors (scaled, constant) with the dependent DOFs that refer to
+    prescribed ones (g = g_p + D g, resolved like T), and the prescribed DOFs; Nones without."""
+    if not rows.values:
+        return None, None, None
+    out = []
+    seen = np.full(n_full, np.nan)
+    for want in (True, False):
+        g = np.zeros(n_full)
+        for d, v, scaled in rows.values:
+            if scaled != want:
+                continue
+            clash = ~np.isnan(seen[d]) & ~np.isclose(seen[d], v)
+            if clash.any():
+                raise ConstraintError(f"a DOF (full DOF {d[clash][0]}) has two different prescribed displacements; "
+                                      "give each support component one value (remove the overlap)")
+            seen[d] = v
+            g[d] = v
+        gp = g.copy()
+        for _ in range(64):
+            gn = gp + D @ g
+            if np.allclose(gn, g, rtol=0.0, atol=1e-14 * max(1.0, np.abs(gn).max())):
+                g = gn
+                break
+            g = gn
+        out.append(g if np.any(g) else None)
+    pres = np.unique(np.concatenate([d[v != 0] for d, v, _ in rows.values]))
+    return out[0], out[1], pres
 
 
 def apply_ties(op: ConstraintOperator, model: Model, dm: DofMap) -> ConstraintOperator:

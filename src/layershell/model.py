@@ -29,12 +29,15 @@ class Layer:
 @dataclass(frozen=True)
 class Fix:
     """Zero displacement of components ``components`` (0..2) of directors ``directors`` of
-    layer ``layer`` at ``nodes``."""
+    layer ``layer`` at ``nodes``; with ``value`` (one number per component) a prescribed
+    displacement instead, multiplied by the load factor when ``scaled`` (displacement control)."""
 
     nodes: np.ndarray
     layer: int
     directors: tuple[int, ...]
     components: tuple[int, ...]
+    value: tuple[float, ...] | None = None
+    scaled: bool = True
 
 
 @dataclass(frozen=True)

@@ -148,6 +148,62 @@ def _restore_zones(zones, extra: dict[str, np.ndarray]) -> None:
     zones.released = [[extra[f"zones.released.{i}"][j].copy() for i in range(n_itf)] for j in range(len(zones.steps))]
 
 
+def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck, on_step_end):
+    """The converged increments of arc-length or adaptive load control, continued from the
+    checkpoint's path state (arc length, constraint, last increment) after a restart."""
+    from .solver.arclength import PathState, path_steps
+
+    ctl = problem.interfaces
+    state = PathState.from_arrays(ck.extra) if ck is not None else None
+
+    def watch(uu, lam):
+        return {p.name: p.value(spec.model, problem.dm, uu, lam, ctl) for p in spec.probes}
+
+    return path_steps(problem, spec.newton, spec.path_following, u0=u, lam0=lam0, step0=step0, state=state,
+                      on_step_end=on_step_end, measure=(lambda pb: pb.interfaces.debonded_fraction())
+                      if ctl is not None else None, watch=watch if spec.probes else None)
+
+
+def _path_arrays(st) -> dict[str, np.ndarray]:
+    state = getattr(st, "state", None)
+    return state.arrays() if state is not None else {}
+
+
+class _JumpWatch:
+    """Jump warnings (issue 13): a step in which the debonded area grows by more than
+    [steps] jump_area of the interface or a probe grows more than jump_ratio times as fast as λ
+    gets a warning on the console (a UserWarning) and in summary.json 'warnings'."""
+
+    def __init__(self, spec: RunSpec, summary: dict, ctl):
+        st = spec.source.steps
+        self.area, self.ratio = st.jump_area, st.jump_ratio
+        self.summary = summary
+        prev = summary["steps"][-1] if summary["steps"] else None
+        self.lam = prev["load_factor"] if prev else 0.0
+        self.probes = prev["probes"] if prev else None
+        self.frac = ctl.debonded_fraction() if ctl is not None else None  # after a restart: the restored state
+
+    def check(self, st, probes: dict, area: dict | None, ctl) -> None:
+        import warnings as _w
+
+        from .solver.arclength import jump_warnings
+
+        frac = ctl.debonded_fraction() if ctl is not None else None
+        msgs = getattr(st, "warnings", None)
+        if msgs is None:  # fixed steps: checked here (arc length and adaptive steps check, and cut, themselves)
+            msgs = jump_warnings(st.step, st.load_factor, self.lam, frac, self.frac, probes, self.probes,
+                                 self.area, self.ratio)
+        for m in msgs:
+            _w.warn(m, JumpWarning, stacklevel=2)
+        if msgs:
+            self.summary.setdefault("warnings", []).extend(msgs)
+        self.lam, self.probes, self.frac = st.load_factor, probes, frac
+
+
+class JumpWarning(UserWarning):
+    """A step with a jump of the debonded area or of a probe."""
+
+
 @dataclass
 class RunResult:
     converged: bool
@@ -352,7 +408,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     problem.monitor = on_iteration  # called by the Newton loop (solver/newton.py)
 
     def checkpoint_summary() -> dict:
-        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds")
+        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end")
                 if k in summary}
 
     if progress is not None and step0:
@@ -365,6 +421,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         steps = (load_steps(problem, spec.load_factors[step0:], spec.newton, u0=u, lam0=lam0, step0=step0,
                             on_step_end=on_step_end if ctl is not None else None, cut=cut)
                  if step0 < n_steps else ())
+        if spec.path_following is not None:  # arc length / adaptive steps (solver/arclength.py)
+            steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None)
+        jumps = _JumpWatch(spec, summary, ctl)
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u
@@ -385,12 +444,19 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,
                                                      **rec["debonded_area"]})
                     summary["first_delamination_load_factor"] = ctl.first_failure()
+                if getattr(st, "state", None) is not None:  # arc length / adaptive: the constraint of the step
+                    rec["path"] = {"constraint": st.state.mode, "size": float(st.state.size),
+                                   "dissipation": float(st.dissipation)}
+                    if getattr(st, "end", None):
+                        summary["path_end"] = st.end  # lambda_end, complete failure or max_steps
+                jumps.check(st, vals, rec.get("debonded_area"), ctl)
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals
                 if rcd is not None:
                     files = None
-                    if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
+                    if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps
+                                            or getattr(getattr(st, "state", None), "finished", False)):
                         from .export import export_step
 
                         paths = export_step(out, st.step, model, problem.dm, u, st.load_factor, ctl,
@@ -403,7 +469,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
                                               ctl.state(problem) if ctl is not None else None, checkpoint_summary(),
-                                              [], {}, _zone_arrays(zones))
+                                              [], {}, {**_zone_arrays(zones), **_path_arrays(st)})
                     checkpoint.save(rcd.path(checkpoint.FILENAME), last, fsync=rcd.sync_due())
                     rcd.summary(summary)
                     log(f"step {st.step} converged: λ = {st.load_factor:.6g}, {st.iterations} iteration(s), "

@@ -31,6 +31,36 @@ from .errors import XYZ, InputError  # defined apart: io/probes.py needs them wi
 from .errors import formula as _formula
 
 
+def _path_settings(st: schema.Steps, model: Model):
+    """PathSettings for [steps] control = 'arc_length' or adaptive = true (None: fixed steps)."""
+    if st.control == "load" and not st.adaptive:
+        return None
+    from ..solver.arclength import PathSettings
+
+    if st.factors is not None:
+        raise InputError("'steps.factors': explicit load factors fix the steps; with control = 'arc_length' or "
+                         "adaptive = true give 'n' and 'lambda_end' instead (the first increment is lambda_end/n)")
+    if st.lambda_end <= 0:
+        raise InputError(f"'steps.lambda_end': {st.lambda_end} must be positive with control = 'arc_length' or "
+                         "adaptive = true")
+    if st.control == "arc_length":
+        scaled = [ld for ld in (*model.surface_loads, *model.edge_loads, *model.nodal_loads) if ld.scaled]
+        if not scaled:
+            raise InputError("'steps.control': 'arc_length' scales the loads with the load factor λ, but the model "
+                             "has no load with scaled = true; add a scaled [[loads]] table, or use control = 'load' "
+                             "(for displacement control a [[supports]] type = 'fix' with 'value')")
+        if any(fx.value is not None and fx.scaled for fx in model.fixes):
+            raise InputError("'steps.control': 'arc_length' scales forces only, but a [[supports]] table prescribes "
+                             "a displacement scaled by λ ('value'); use control = 'load' for displacement control, "
+                             "or set scaled = false on that support")
+    inc = st.lambda_end / st.n
+    return PathSettings(control=st.control, lambda_end=st.lambda_end, increment=inc,
+                        increment_max=st.increment_max, arc_length=st.arc_length, arc_length_min=st.arc_length_min,
+                        arc_length_max=st.arc_length_max, dissipation=st.dissipation,
+                        dissipation_threshold=st.dissipation_threshold, max_steps=st.max_steps,
+                        max_cuts=max(st.max_bisections, 1), jump_area=st.jump_area, jump_ratio=st.jump_ratio)
+
+
 @dataclass
 class RunSpec:
     model: Model
@@ -42,6 +72,7 @@ class RunSpec:
     path: Path | None = None
     profiles: list = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # input that is valid but almost surely not meant
+    path_following: object = None  # solver.arclength.PathSettings ([steps] control/adaptive), None: fixed steps
 
 
 def _fmt_loc(loc) -> str:
@@ -796,7 +827,13 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             dirs = tuple(range(d + 1)) if sd.directors == "all" else tuple(sd.directors)
             if any(l > d or l < 0 for l in dirs):
                 raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dirs)}")
-            model.fixes.append(Fix(nodes, k, dirs, tuple(XYZ.index(c) for c in sd.components)))
+            value = None
+            if sd.value is not None:
+                if len(sd.value) != len(sd.components):
+                    raise InputError(f"'{f}.value': give one prescribed displacement per entry of 'components' "
+                                     f"({len(sd.components)}: {list(sd.components)}), got {len(sd.value)}")
+                value = tuple(float(x) for x in sd.value)
+            model.fixes.append(Fix(nodes, k, dirs, tuple(XYZ.index(c) for c in sd.components), value, sd.scaled))
         elif sd.type == "symmetry":
             model.symmetries.append(Symmetry(nodes, _vec(sd.normal, f + ".normal")))
         else:
@@ -927,4 +964,5 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     spec = RunSpec(model, lf, newton, probes, mf.output, mf)
     spec.profiles = list(mf.profiles)
     spec.warnings = notes
+    spec.path_following = _path_settings(st, model)
     return spec

@@ -265,6 +265,11 @@ class FixDef(Strict):
                           "the layer containing it; at an interface the upper one)")
     direction: Vec3 | None = Field(
         None, description="held direction (global vector, e.g. [0, 0, 1] for a bearing); instead of 'components'")
+    value: list[FiniteFloat] | None = Field(
+        None, description="prescribed displacement instead of zero: one value per entry of 'components' (length "
+                          "units; for directors 1.. the director's units), multiplied by the load factor λ when "
+                          "'scaled' (displacement control); the reaction there is f_int − F_ext")
+    scaled: bool = Field(True, description="with 'value': multiplied by the load factor λ (false: constant)")
 
 
 class SymmetryDef(Strict):
@@ -380,6 +385,42 @@ class Steps(Strict):
         "(semi-smooth and active-set loops) before the load increment is bisected")
     solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
         "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
+    control: Literal["load", "arc_length"] = Field(
+        "load", description="'load': the load factor λ is stepped (it scales forces and prescribed support "
+        "displacements alike: displacement control is a [[supports]] 'fix' with 'value'); 'arc_length': λ is an "
+        "unknown of every increment (Crisfield's cylindrical arc length, switching to the dissipation-based "
+        "constraint once energy is dissipated), so the path may pass limit points and snap-backs (λ decreases); "
+        "the first increment is lambda_end/n, the run ends at λ = lambda_end, when λ falls below 0.1 % of its "
+        "peak (complete failure) or after max_steps increments; the steps are sized automatically")
+    adaptive: bool = Field(
+        False, description="control = 'load': automatic step size - the first increment is lambda_end/n, it grows "
+        "(at most 2×) after increments with few Newton iterations and is halved after a failed one, up to "
+        "increment_max; every converged increment is a step in probes.csv")
+    increment_max: PositiveFloat | None = Field(
+        None, description="adaptive load control: the largest load-factor increment (default 10 × lambda_end/n)")
+    arc_length: PositiveFloat | None = Field(
+        None, description="control = 'arc_length': the first arc length, the norm of the increment of the "
+        "independent DOFs (length units; default: that of the linear predictor for Δλ = lambda_end/n)")
+    arc_length_min: PositiveFloat | None = Field(
+        None, description="control = 'arc_length': the smallest arc length before the run stops (default "
+        "arc_length/1000)")
+    arc_length_max: PositiveFloat | None = Field(
+        None, description="control = 'arc_length': the largest arc length (default 10 × arc_length)")
+    dissipation: bool = Field(
+        True, description="control = 'arc_length': switch to the dissipation-based constraint (Gutiérrez 2004; "
+        "Verhoosel, Remmers & Gutiérrez 2009) once an increment dissipates energy (damage with secant unloading)")
+    dissipation_threshold: PositiveFloat = Field(
+        1e-3, description="the switch: an increment's dissipation ½F̂ᵀ(λ₀Δu − Δλu₀) above this fraction of the "
+        "elastic energy ½λF̂ᵀu")
+    max_steps: PositiveInt = Field(
+        1000, le=1_000_000, description="control = 'arc_length' or adaptive: the most increments of the run")
+    jump_area: float | None = Field(
+        0.2, gt=0, le=1, description="warn (console and summary.json 'warnings') when the debonded area grows by "
+        "more than this fraction of the interface in one step; adaptive and arc-length control cut such a step "
+        "first")
+    jump_ratio: float | None = Field(
+        3.0, gt=1, description="warn when a probe grows more than this many times as fast as λ in one step "
+        "(|v/v_prev| > jump_ratio · max(1, λ/λ_prev)); adaptive and arc-length control cut such a step first")
 
 
 class ProbeDef(Strict):

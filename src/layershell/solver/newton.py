@@ -78,6 +78,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     Both use the residual line search for contact (full Newton steps in the semi-smooth phase
     cut the pull-off's time by about 10 % but took 2.5× the iterations in the §5.1 plate's first
     debonding step and failed there without any line search)."""
+    u = problem.impose(u, lam)  # prescribed displacements at this load factor (displacement control)
     blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
     if not blocks:
         return newton_fixed_set(problem, u, lam, s)
@@ -143,8 +144,10 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     iterations have not brought the residual below its starting value; ``give_up_if(u)``: stop
     when it returns True for the current iterate."""
     op = problem.op
+    u = problem.impose(u, lam)
     Fext = problem.external(lam)
     ref = np.linalg.norm(op.reduce(Fext))
+    pres = op.prescribed  # displacement control: the reactions there set the force scale
     res = NewtonResult(False, 0)
     e0 = en = None
     monitor = getattr(problem, "monitor", None)  # progress/run.log: (iteration, λ, ‖r‖, reference, energy norm, u)
@@ -162,6 +165,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.message = "residual is not finite"
             return u, res
         scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
+        if pres is not None:
+            scale = max(ref, float(np.linalg.norm(f[pres] - Fext[pres])), 1e-300)
         if monitor is not None:
             monitor(it, lam, rn, scale, en, u)
         if it > 0 and rn <= s.tol_residual * scale:

@@ -74,6 +74,31 @@ class Problem:
         self.interfaces.restore(self, snap["state"])
         self.interfaces.resolves = snap["resolves"]  # re-solutions so far in this load step
 
+    @property
+    def prescribed(self) -> bool:
+        """The model has prescribed (non-zero) support displacements."""
+        return self.op is not None and self.op.prescribed is not None
+
+    def impose(self, u: np.ndarray, lam: float) -> np.ndarray:
+        """``u`` with the constraints u = T u_r + λ g_scaled + g_const imposed at load factor
+        ``lam`` (u_r are the independent entries of ``u``); ``u`` itself without prescribed
+        displacements."""
+        op = self.op
+        if op.prescribed is None:
+            return u
+        v = op.expand(u[op.independent])
+        if op.g_scaled is not None:
+            v += lam * op.g_scaled
+        if op.g_const is not None:
+            v += op.g_const
+        return v
+
+    def reactions(self, u: np.ndarray, lam: float) -> np.ndarray:
+        """Full-space support reactions f_int(u) − F_ext(λ) (non-zero at constrained DOFs only
+        at equilibrium; at a prescribed DOF the force the support applies)."""
+        f, _ = self.assembler.evaluate(u, tangent=False)
+        return f - self.external(lam)
+
     def external(self, lam: float) -> np.ndarray:
         F = lam * self.F_scaled + self.F_const
         return F if self.F_friction is None else F + self.F_friction

@@ -1,0 +1,430 @@
+"""Path following: adaptive load stepping and arc-length control with step-size control.
+
+* Load control with automatic step size: Δλ grows after easy increments and is halved after a
+  failed one, bounded by ``increment_max`` and ``increment_min``.
+* Arc-length control (Riks 1979; Crisfield 1981, "A fast incremental/iterative solution
+  procedure that handles snap-through", Comput. Struct. 13): the load factor is an unknown and
+  the increment satisfies ‖Δu_r‖² + ψ² Δλ² ‖q‖² = Δl² (ψ = 0: cylindrical, ψ = 1: spherical),
+  q = Tᵀ F_scaled. Each iteration solves K_r [a, b] = [r, q] with one factorisation (bordering
+  by superposition, δu = a + δλ b); δλ is the root of the quadratic constraint closest to the
+  previous increment (Crisfield). Predictor sign: the previous increment's direction
+  (sign Δuₚᵣₑᵥ · δu_t > 0; Feng, Perić & Owen 1996); on the first increment and after an
+  increment that changed the state (debonding) the work criterion sign(Δλ) = sign(qᵀδu_t)
+  (load further where the current state is stable under load control, unload where it is not).
+* Dissipation-based control (Gutiérrez 2004, Int. J. Numer. Meth. Engng 59; Verhoosel,
+  Remmers & Gutiérrez 2009, Int. J. Numer. Meth. Engng 77): for damage with secant unloading the
+  energy dissipated in an increment from (u₀, λ₀) is ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀), linear in the
+  unknowns; the constraint ΔG = Δτ replaces the arc length once a converged increment
+  dissipated more than ``dissipation_threshold`` × the elastic energy ½ λ F̂ᵀu (Verhoosel's
+  switch); where an increment cannot dissipate (elastic unloading) it goes back to the arc length.
+
+After a converged increment ``on_step_end(problem, u, λ)`` may change the state (debonding,
+damage history); a True return re-solves the same increment (from the same start and with the
+same constraint) in the new state. An increment whose debonded area grows by more than
+``jump_area`` of the interface, or in which a watched probe grows more than ``jump_ratio`` times
+faster than λ, is undone and cut; where cutting down to the minimum size does not help, it is
+accepted with a warning (:func:`jump_warnings`).
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Callable, Iterator
+
+import numpy as np
+
+from . import linear
+from .newton import ConvergenceError, NewtonSettings, StepResult, newton
+from .problem import Problem
+
+
+class PathError(ValueError):
+    """A path-following setting that does not fit the model."""
+
+
+@dataclass
+class PathSettings:
+    """[steps] settings of path following (see the model-file keys of the same names)."""
+
+    control: str = "load"  # "load" (adaptive Δλ) or "arc_length"
+    lambda_end: float = 1.0
+    increment: float = 0.1  # first Δλ (load control); arc length: sets the first arc length
+    increment_max: float | None = None  # default 10 × increment (load control)
+    arc_length: float | None = None  # first Δl; default: ‖Δu_r‖ of the linear predictor for ``increment``
+    arc_length_min: float | None = None  # default arc_length / 1000
+    arc_length_max: float | None = None  # default 10 × arc_length
+    psi: float = 0.0
+    dissipation: bool = True
+    dissipation_threshold: float = 1e-3
+    target_iterations: int = 8  # Newton iterations of a 'normal' increment: ×(8/its), within [½, 2]
+    max_steps: int = 1000
+    end_fraction: float = 1e-3  # arc length: the path ends when λ falls below this fraction of its peak
+    max_cuts: int = 12
+    max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
+    jump_area: float | None = 0.2
+    jump_ratio: float | None = 3.0
+
+
+@dataclass
+class PathState:
+    """What continues a path after a restart (stored in checkpoint.npz as ``path.*``)."""
+
+    mode: str = ""  # "load", "arc" or "dissipation"; "" before the first increment
+    size: float = 0.0  # Δλ, Δl or Δτ of the next increment
+    arc_length: float = 0.0  # the arc length (kept while the dissipation constraint acts)
+    du_prev: np.ndarray | None = None  # full-space increment of the last step (predictor sign)
+    lam_peak: float = 0.0  # largest |λ| so far
+    dissipated: float = 0.0  # Σ ΔG of the increments so far
+    finished: bool = False
+    arc_length0: float = 0.0  # the first arc length (sets the default bounds)
+    changed: bool = False  # the last increment changed the state (debonding): work criterion next
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
+               "path.arc_length": np.array(self.arc_length), "path.lam_peak": np.array(self.lam_peak),
+               "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
+               "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed)}
+        if self.du_prev is not None:
+            out["path.du_prev"] = self.du_prev.copy()
+        return out
+
+    @classmethod
+    def from_arrays(cls, a: dict[str, np.ndarray]) -> "PathState | None":
+        if "path.mode" not in a:
+            return None
+        return cls(str(a["path.mode"]), float(a["path.size"]), float(a["path.arc_length"]),
+                   np.array(a["path.du_prev"], float) if "path.du_prev" in a else None,
+                   float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
+                   float(a["path.arc_length0"]), bool(a["path.changed"]))
+
+
+@dataclass
+class Attempt:
+    converged: bool
+    u: np.ndarray
+    lam: float
+    iterations: int
+    residuals: list[float] = field(default_factory=list)
+    message: str = ""
+
+
+def check_path(problem: Problem, ps: PathSettings) -> None:
+    """Raise PathError where arc-length control cannot work on ``problem``."""
+    if ps.control != "arc_length":
+        return
+    if not np.any(problem.F_scaled):
+        raise PathError("'steps.control' = 'arc_length' scales the loads with the load factor λ, but the model has "
+                        "no load with scaled = true (or its loads sum to zero); add a scaled [[loads]] table, or "
+                        "use control = 'load' (a prescribed displacement: [[supports]] type = 'fix' with 'value')")
+    if problem.op.g_scaled is not None:
+        raise PathError("'steps.control' = 'arc_length' with a prescribed displacement that is scaled by λ "
+                        "([[supports]] with 'value'): arc-length control scales forces only; use control = 'load' "
+                        "for displacement control, or set scaled = false on that support")
+
+
+def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float) -> float:
+    """ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀): energy dissipated by secant-unloading damage in the increment
+    (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20))."""
+    F = problem.F_scaled
+    return 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
+
+
+def _contact_blocks(problem: Problem) -> None:
+    for b in problem.assembler.extra:
+        if hasattr(b, "unfreeze"):
+            b.unfreeze()  # contact set from the current gap in every iteration (semi-smooth)
+
+
+def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
+                du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float) -> Attempt:
+    """One increment from the equilibrium (u0, λ0) under the arc-length (``mode = "arc"``, Δl =
+    ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``)."""
+    op, asm = problem.op, problem.assembler
+    _contact_blocks(problem)
+    q = op.reduce(problem.F_scaled)
+    qq = float(q @ q)
+    nq = math.sqrt(qq)
+    Fc_r = op.reduce(problem.F_const)
+    solver = problem.linear_solver(s.backend)
+    att = Attempt(False, u0, lam0, 0)
+    try:
+        _, Kr = asm.evaluate_reduced(u0, op)
+        dut = solver.solve(Kr, q)
+    except linear.SingularSystemError as exc:
+        att.message = f"singular tangent ({exc})"
+        return att
+    dUt = op.expand(dut)
+    if mode == "arc":
+        dlam = size / math.sqrt(float(dut @ dut) + ps.psi**2 * qq)
+        if (float(du_prev @ dUt) if du_prev is not None else float(q @ dut)) < 0.0:
+            dlam = -dlam
+    else:
+        F = problem.F_scaled
+        den = 0.5 * (lam0 * float(F @ dUt) - float(F @ u0))
+        if abs(den) <= 1e-6 * 0.5 * (abs(lam0 * float(F @ dUt)) + abs(float(F @ u0))):
+            att.message = "no dissipation in the predictor direction"
+            return att
+        dlam = size / den
+    dur = dlam * dut
+    for it in range(s.max_iterations + 1):
+        lam = lam0 + dlam
+        u = u0 + op.expand(dur)
+        f, _ = asm.evaluate(u, tangent=False)  # the tangent only where an iteration follows
+        r = op.reduce(problem.external(lam) - f)
+        rn = float(np.linalg.norm(r))
+        att.residuals.append(rn)
+        att.u, att.lam, att.iterations = u, lam, it
+        if not np.isfinite(rn):
+            att.message = "residual is not finite"
+            return att
+        scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
+        if it > 0 and rn <= s.tol_residual * scale:
+            att.converged = True
+            return att
+        if it == s.max_iterations:
+            break
+        try:
+            _, Kr = asm.evaluate_reduced(u, op)
+            ab = solver.solve(Kr, np.column_stack([r, q]))
+        except linear.SingularSystemError as exc:
+            att.message = f"singular tangent ({exc})"
+            return att
+        a, b = ab[:, 0], ab[:, 1]
+        if mode == "arc":
+            # ‖dur + a + δλ b‖² + ψ²(Δλ + δλ)² qq = Δl²  (Crisfield 1981)
+            w = dur + a
+            A = float(b @ b) + ps.psi**2 * qq
+            B = 2.0 * float(w @ b) + 2.0 * ps.psi**2 * qq * dlam
+            C = float(w @ w) + ps.psi**2 * qq * dlam**2 - size**2
+            disc = B * B - 4.0 * A * C
+            if disc < 0.0:  # no intersection: the point of the line closest to the constraint
+                roots = [-B / (2.0 * A)]
+            else:
+                sq = math.sqrt(disc)
+                roots = [(-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A)]
+            # the root whose increment keeps the direction of the current one
+            dl = max(roots, key=lambda x: float((w + x * b) @ dur) + ps.psi**2 * qq * (dlam + x) * dlam)
+        else:
+            # ½ F̂ᵀ(λ₀ (Δu + a + δλ b) − (Δλ + δλ) u₀) = Δτ  (linear in δλ)
+            F = problem.F_scaled
+            Fa, Fb = float(F @ op.expand(a)), float(F @ op.expand(b))
+            Fu0, Fdu = float(F @ u0), float(F @ op.expand(dur))
+            g = 0.5 * (lam0 * (Fdu + Fa) - dlam * Fu0) - size
+            dg = 0.5 * (lam0 * Fb - Fu0)
+            if dg == 0.0:
+                att.message = "the dissipation constraint does not depend on λ here"
+                return att
+            dl = -g / dg
+        dur = dur + a + dl * b
+        dlam += dl
+    att.message = f"no convergence in {s.max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
+    return att
+
+
+def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, area_prev: float | None,
+                  probes: dict[str, float] | None, probes_prev: dict[str, float] | None,
+                  jump_area: float | None, jump_ratio: float | None) -> list[str]:
+    """Warnings for a step in which the debonded fraction of the interface grew by more than
+    ``jump_area`` or a probe grew more than ``jump_ratio`` times as fast as the load factor
+    (|v/v_prev| > jump_ratio · max(1, |λ/λ_prev|), only where |v_prev| > 0)."""
+    out = []
+    if jump_area is not None and area is not None and area_prev is not None and area - area_prev > jump_area:
+        out.append(f"step {step} (λ = {lam:.6g}): the debonded area jumped from {100 * area_prev:.3g} % to "
+                   f"{100 * area:.3g} % of the interface in one step; reduce the step size or use control = "
+                   "'arc_length' to follow the debonding")
+    if jump_ratio is not None and probes and probes_prev:
+        grow = max(1.0, abs(lam / lam_prev)) if lam_prev else 1.0
+        for k, v in probes.items():
+            v0 = probes_prev.get(k)
+            if v0 is None or not np.isfinite(v) or not np.isfinite(v0) or abs(v0) <= 1e-12 * max(abs(v), 1e-300):
+                continue
+            if abs(v / v0) > jump_ratio * grow:
+                out.append(f"step {step} (λ = {lam:.6g}): probe '{k}' jumped from {v0:.6g} to {v:.6g} "
+                           f"({abs(v / v0):.3g}× while λ changed {grow:.3g}×)")
+    return out
+
+
+def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.ndarray | None = None,
+               lam0: float = 0.0, step0: int = 0, state: PathState | None = None,
+               on_step_end: Callable[[Problem, np.ndarray, float], bool] | None = None,
+               measure: Callable[[Problem], float] | None = None,
+               watch: Callable[[np.ndarray, float], dict[str, float]] | None = None,
+               max_resolves: int = 200) -> Iterator[StepResult]:
+    """Converged increments along the equilibrium path (see the module docstring); each
+    :class:`StepResult` carries ``state`` (a :class:`PathState`) and ``warnings``. Ends at
+    λ = ``lambda_end`` (load control, or arc length on a rising branch: the last increment is a
+    load-controlled one to λ_end exactly), when λ falls below ``end_fraction`` of its peak
+    (complete failure), or after
+    ``max_steps`` increments."""
+    check_path(problem, ps)
+    u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
+    lam = lam0
+    st = state or PathState()
+    if st.finished:
+        return
+    arc = ps.control == "arc_length"
+    if not st.mode:
+        st.mode = "arc" if arc else "load"
+        st.size = ps.increment
+        if arc:
+            st.arc_length = st.size = ps.arc_length if ps.arc_length is not None else _first_arc_length(problem, u, s, ps)
+            st.arc_length0 = st.arc_length
+    l0 = st.arc_length0
+    dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 / 1000.0
+    dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * l0
+    inc_max = ps.increment_max if ps.increment_max is not None else 10.0 * ps.increment
+    inc_min = ps.increment * 0.5**ps.max_cuts
+    area_prev = measure(problem) if measure is not None else None
+    probes_prev = watch(u, lam) if watch is not None else None
+    end = ps.lambda_end
+    for n in range(step0 + 1, ps.max_steps + 1):
+        t0 = time.perf_counter()
+        total_it, cuts, resolves = 0, 0, 0
+        residuals: list[float] = []
+        allow_jump = tried_dissipation = False
+        warns: list[str] = []
+        while True:
+            snap = problem.snapshot() if on_step_end is not None else None
+            to_end = False
+            if st.mode == "load":
+                dlam = min(st.size, end - lam)
+                to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
+                trial = end if to_end else lam + dlam
+                u_new, res = newton(problem, u, trial, s)
+                att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
+            else:
+                att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
+                                  max(st.lam_peak, abs(lam)))
+                if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
+                    u_new, res = newton(problem, u, end, s)
+                    if res.converged:
+                        att = Attempt(True, u_new, end, att.iterations + res.iterations,
+                                      att.residuals + res.residuals)
+                        to_end = True
+            total_it += att.iterations
+            residuals += att.residuals
+            ok = att.converged
+            msg = att.message
+            if ok and on_step_end is not None:
+                a0 = measure(problem) if measure is not None else None
+                while on_step_end(problem, att.u, att.lam):
+                    resolves += 1
+                    if (not allow_jump and a0 is not None and ps.jump_area is not None
+                            and measure(problem) - a0 > ps.jump_area):
+                        ok, msg = False, "debonding jump"
+                        break
+                    if resolves > max_resolves:
+                        ok, msg = False, f"the state still changes after {max_resolves} re-solutions"
+                        break
+                    if st.mode == "load" or to_end:
+                        u_new, res = newton(problem, att.u, att.lam, s)
+                        att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
+                    else:  # the same increment again under the same constraint in the new state
+                        att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,
+                                          max(st.lam_peak, abs(lam)))  # sign: the work criterion in the new state
+                    total_it += att.iterations
+                    residuals += att.residuals
+                    if not att.converged:
+                        ok, msg = False, att.message
+                        break
+            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
+                    and float((att.u - u) @ st.du_prev) < 0.0):
+                ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
+            if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
+                if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio):
+                    ok, msg = False, "probe jump"
+            if ok:
+                break
+            if snap is not None:
+                problem.restore(snap)
+            if st.mode == "dissipation" and msg.startswith("no dissipation"):
+                st.mode, st.size = "arc", st.arc_length  # elastic branch: back to the arc length
+                continue
+            if st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0:
+                # e.g. at a peak where damage starts: the arc length cannot pick the branch, the
+                # dissipation constraint can (its predictor sign follows from the tangent)
+                tried_dissipation = True
+                st.mode = "dissipation"
+                st.size = _first_dissipation(problem, u, lam, st.size)
+                continue
+            if st.mode == "dissipation" and tried_dissipation and cuts >= 3:
+                st.mode, st.size = "arc", st.arc_length  # it did not help: the arc length again, cut
+            cuts += 1
+            small = ((st.mode == "load" and st.size * 0.5 < inc_min)
+                     or (st.mode == "arc" and st.size * 0.5 < dl_min))
+            jump = msg in ("debonding jump", "probe jump")
+            if cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts):
+                if jump:
+                    allow_jump = True  # cutting does not help: accept the jump, with a warning
+                    continue
+                if st.mode == "dissipation":  # once per increment: then the arc length alone
+                    st.mode, st.size = "arc", st.arc_length
+                    cuts, tried_dissipation = 0, True
+                    continue
+                if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
+                    return  # complete failure: nothing left to carry the load (the tangent is singular)
+                raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
+                                       f"cuts ({msg}); the last converged load factor is {lam:.6g}",
+                                       lam, residuals[-1] if residuals else float("nan"))
+            st.size *= 0.5
+        # accepted increment
+        du = att.u - u
+        dlam = att.lam - lam
+        dG = dissipation_increment(problem, u, lam, du, dlam)
+        st.dissipated += dG
+        area = measure(problem) if measure is not None else None
+        probes = watch(att.u, att.lam) if watch is not None else None
+        warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio)
+        area_prev, probes_prev = area, probes
+        # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
+        its = max(att.iterations, 1)
+        fac = min(2.0, max(0.5, ps.target_iterations / its))
+        if cuts:
+            fac = min(fac, 1.0)  # no growth right after a cut
+        if st.mode == "load":
+            st.size = min(max(st.size * fac, inc_min), inc_max)
+        elif st.mode == "arc":
+            st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
+            elastic = 0.5 * abs(att.lam * float(problem.F_scaled @ att.u))
+            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > 0:
+                st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
+        else:
+            st.size = st.size * fac
+            st.arc_length = max(min(float(np.linalg.norm(du[problem.op.independent])), dl_max), dl_min)
+        st.du_prev = du
+        st.changed = resolves > 0
+        u, lam = att.u, att.lam
+        st.lam_peak = max(st.lam_peak, abs(lam))
+        if st.mode == "load":
+            st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
+        else:
+            st.finished = (to_end or lam >= end
+                           or (st.lam_peak > 0 and dlam < 0 and lam <= ps.end_fraction * st.lam_peak))
+        end_reason = None
+        if st.finished:
+            end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
+        elif n == ps.max_steps:
+            st.finished, end_reason = True, "max_steps"
+        res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
+        res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
+                              st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed)
+        res.warnings = warns
+        res.dissipation = dG
+        res.end = end_reason  # why the path ends here ("lambda_end", "complete failure", "max_steps"), else None
+        yield res
+        if st.finished:
+            return
+
+
+def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -> float:
+    """A first Δτ: the elastic energy ½ λ F̂ᵀu times the relative size of the arc length."""
+    un = float(np.linalg.norm(u[problem.op.independent]))
+    return 0.5 * abs(lam * float(problem.F_scaled @ u)) * min(1.0, dl / max(un, 1e-300)) * 0.5
+
+
+def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: PathSettings) -> float:
+    """‖δu_r‖ of the linear predictor for the load increment ``ps.increment``."""
+    _, Kr = problem.assembler.evaluate_reduced(u, problem.op)
+    dut = problem.linear_solver(s.backend).solve(Kr, problem.op.reduce(problem.F_scaled))
+    return abs(ps.increment) * float(np.linalg.norm(dut))

@@ -1,0 +1,419 @@
+"""Path following (issue 13 item 2): displacement control, arc length, step control.
+
+References are independent of the method under test: the force-controlled solution of the same
+model (uniqueness of the equilibrium), analytic limit points and analytic softening curves.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from layershell.io.build import build, parse
+from layershell.runner import run
+from layershell.solver.problem import Problem
+
+CANTILEVER = """
+[model]
+title = "cantilever"
+nonlinear = {nonlinear}
+[mesh]
+type = "rectangle"
+lx = 10.0
+ly = 1.0
+nx = 4
+ny = 1
+[materials.m]
+type = "isotropic"
+E = 1000.0
+nu = 0.0
+[[layers]]
+name = "beam"
+material = "m"
+thickness = 0.5
+directors = 1
+[[supports]]
+type = "fix"
+where = "near(x, 0)"
+directors = "all"
+{tip}
+[steps]
+n = {n}
+{steps}
+[[probes]]
+name = "w"
+quantity = "displacement"
+point = [10, 0, 0]
+component = "z"
+"""
+FORCE_TIP = """
+[[loads]]
+type = "edge"
+where = "near(x, 10)"
+direction = [0, 0, 1]
+distribution = {P}
+face = "reference"
+"""
+DISP_TIP = """
+[[supports]]
+type = "fix"
+where = "near(x, 10)"
+components = ["z"]
+value = [{w}]
+"""
+
+
+def _spec(tip: str, nonlinear: bool = False, n: int = 1, steps: str = ""):
+    return build(parse(CANTILEVER.format(nonlinear=str(nonlinear).lower(), tip=tip, n=n, steps=steps)))
+
+
+def _tip_dofs(spec, problem):
+    nodes = np.flatnonzero(np.isclose(spec.model.mesh.nodes[:, 0], 10.0))
+    return problem.dm.layer_dofs[0][nodes, 0, 2]
+
+
+@pytest.mark.parametrize("nonlinear", [False, True])
+def test_displacement_control_reproduces_force_control(nonlinear):
+    """Prescribing the tip deflection of a force-controlled run gives back its solution, and the
+    reaction f_int − F_ext at the prescribed DOFs sums to the applied force (ν = 0: the tip
+    deflection is uniform across the width, so the force-controlled solution satisfies the
+    displacement condition and is the unique solution of the displacement-controlled problem)."""
+    P = 0.02 if not nonlinear else 0.15  # line force per width; nonlinear: w/l ≈ 0.4
+    n = 1 if not nonlinear else 4
+    fs = _spec(FORCE_TIP.format(P=P), nonlinear, n)
+    rf = run(fs)
+    assert rf.converged
+    wdofs = _tip_dofs(fs, rf.problem)
+    w = rf.u[wdofs]
+    assert np.ptp(w) <= 1e-9 * abs(w).max()  # uniform tip deflection
+    if not nonlinear:  # and the independent beam answer: w = P l³ / (3 E I) per width
+        assert w[0] == pytest.approx(P * 10.0**3 / (3 * 1000.0 * 0.5**3 / 12), rel=0.02)
+    ds = _spec(DISP_TIP.format(w=float(w[0])), nonlinear, n)
+    rd = run(ds)
+    assert rd.converged
+    assert np.allclose(rd.u, rf.u, rtol=0, atol=1e-7 * abs(rf.u).max())
+    R = rd.problem.reactions(rd.u, 1.0)
+    assert R[_tip_dofs(ds, rd.problem)].sum() == pytest.approx(P * 1.0, rel=1e-6)  # line force × width
+    # at a free DOF there is no reaction (equilibrium)
+    free = rd.problem.op.independent
+    assert np.abs(R[free]).max() <= 1e-6 * P
+    # the load factor scales the prescribed value: half-way the deflection is half (linear)
+    if not nonlinear:
+        assert rd.summary["probes"]["w"] == pytest.approx(w[0], rel=1e-12)
+
+
+def test_prescribed_value_needs_one_number_per_component():
+    from layershell.io.build import InputError
+
+    with pytest.raises(InputError, match=r"supports\[1\].value"):
+        _spec(DISP_TIP.format(w="1.0, 2.0"))
+
+
+# ------------------------------------------------------------------ softening: bar + cohesive spring
+# A membrane strip (only the axial displacements free: y, z of every director and x of director 1
+# fixed; ν = 0) of compliance c_e = L/(E b t) in series with a softening spring between its end
+# x = 0 and the ground. Spring: bilinear in δ = Σ w_i u_x,i over the end nodes (w = 1/6, 4/6, 1/6,
+# the consistent weights of the edge), F_s = k0 δ up to δ0 = F_p/k0, then linear softening to zero
+# at δ_f; damage with secant unloading, irreversible (history κ updated at converged steps). Load:
+# F = λ F̂ at x = L. Analytic path: u_L = c_e F + δ with F = F_s(δ): snap-back where
+# c_e > (δ_f − δ0)/F_p, and the total dissipation is ½ F_p δ_f.
+STRIP = """
+[model]
+title = "strip"
+nonlinear = false
+[mesh]
+type = "rectangle"
+lx = 10.0
+ly = 1.0
+nx = 2
+ny = 1
+[materials.m]
+type = "isotropic"
+E = 1000.0
+nu = 0.0
+[[layers]]
+name = "bar"
+material = "m"
+thickness = 1.0
+directors = 1
+[[supports]]
+type = "fix"
+where = "x > -1"
+directors = "all"
+components = ["y", "z"]
+[[supports]]
+type = "fix"
+where = "x > -1"
+directors = [1]
+components = ["x"]
+[[loads]]
+type = "edge"
+where = "near(x, 10)"
+direction = [1, 0, 0]
+distribution = 1.0
+face = "reference"
+[steps]
+n = 10
+{steps}
+[[probes]]
+name = "u_end"
+quantity = "displacement"
+point = [10, 0, 0]
+component = "x"
+"""
+C_E = 10.0 / (1000.0 * 1.0 * 1.0)  # L / (E b t)
+K0, FP, DF = 1000.0, 1.0, 0.006  # spring stiffness, peak force (λ = 1), separation at zero force
+D0 = FP / K0
+
+
+class SofteningSpring:
+    """Element-like block (assembly.Assembler.add_blocks): one spring on δ = w · u[dofs]."""
+
+    symmetric = True
+
+    def __init__(self, dofs, w, df):
+        self.dofs = np.asarray(dofs)[None, :]
+        self.w = np.asarray(w, float)
+        self.df = df
+        self.kappa = 0.0  # history: largest δ at a converged step
+
+    def law(self, d):
+        """(force, tangent) of the damage law at δ = d with the current history; at the peak
+        (κ = δ0 within round-off) the tangent of further loading is the softening one."""
+        DF = self.df
+        k = max(self.kappa, d)
+        at_peak = d >= self.kappa and k >= D0 * (1 - 1e-9)
+        if k < D0 and not at_peak:
+            return K0 * d, K0
+        k = max(k, D0)
+        soft = max(FP * (DF - k) / (DF - D0), 1e-9 * FP)  # force on the envelope at κ
+        sec = soft / k
+        if d >= self.kappa:  # loading on the softening envelope
+            return (soft if d >= D0 else K0 * d), (-FP / (DF - D0) if soft > 1e-9 * FP else 0.0)
+        return sec * d, sec  # secant unloading
+
+    def response(self, u, tangent=True):
+        d = float(self.w @ u[self.dofs[0]])
+        F, k = self.law(d)
+        fe = (F * self.w)[None, :]
+        Ke = (k * np.outer(self.w, self.w))[None] if tangent else None
+        return fe, Ke
+
+    def commit(self, u):
+        self.kappa = max(self.kappa, float(self.w @ u[self.dofs[0]]))
+        return False
+
+
+def _strip(df: float, steps: str = ""):
+    spec = build(parse(STRIP.format(steps=steps)))
+    pb = Problem.build(spec.model)
+    x = spec.model.mesh.nodes
+    end = np.flatnonzero(np.isclose(x[:, 0], 0.0))
+    end = end[np.argsort(x[end, 1])]
+    spring = SofteningSpring(pb.dm.layer_dofs[0][end, 0, 0], [1 / 6, 4 / 6, 1 / 6], df)
+    pb.assembler.add_blocks([spring])
+    tip = np.flatnonzero(np.isclose(x[:, 0], 10.0))
+    tip = tip[np.argsort(x[tip, 1])]
+    return spec, pb, spring, pb.dm.layer_dofs[0][tip, 0, 0]
+
+
+def _trace(control: str, df: float, **kw):
+    from layershell.solver.arclength import PathSettings, path_steps
+
+    spec, pb, spring, tipdofs = _strip(df)
+    ps = PathSettings(control=control, lambda_end=2.0, increment=0.1, max_steps=400, **kw)
+    pts = []
+    for st in path_steps(pb, spec.newton, ps, on_step_end=lambda p, u, lam: spring.commit(u)):
+        d = float(spring.w @ st.u[spring.dofs[0]])
+        ul = float(np.array([1 / 6, 4 / 6, 1 / 6]) @ st.u[tipdofs])
+        pts.append((st.load_factor, d, ul, st.state.mode, st.dissipation, st.iterations))
+    return pts, spring
+
+
+def _check_on_analytic_path(pts, df):
+    """Every converged point lies on the analytic equilibrium path: F = F_s(δ) on the elastic
+    line or the softening envelope, and u_L = c_e F + δ."""
+    for lam, d, ul, *_ in pts:
+        assert ul == pytest.approx(C_E * lam + d, abs=1e-9)
+        if d <= D0 * (1 + 1e-9):
+            assert lam == pytest.approx(K0 * d, abs=1e-8)
+        else:
+            assert lam == pytest.approx(max(FP * (df - d) / (df - D0), 0.0), abs=1e-8)
+
+
+def _corner(pts):
+    """The limit point from the traced path: the intersection of the line through two points
+    before the peak with the line through two points after it (the path is piecewise linear in
+    (δ, λ))."""
+    lam = np.array([p[0] for p in pts])
+    d = np.array([p[1] for p in pts])
+    pre = np.flatnonzero(d < D0 * (1 - 1e-9))[-2:]
+    post = np.flatnonzero((d > D0 * (1 + 1e-9)) & (lam > 1e-3))[:2]
+    s1 = np.polyfit(d[pre], lam[pre], 1)
+    s2 = np.polyfit(d[post], lam[post], 1)
+    dc = (s2[1] - s1[1]) / (s1[0] - s2[0])
+    return float(np.polyval(s1, dc))
+
+
+def test_arc_length_traces_softening_past_the_limit_point():
+    """Crisfield's cylindrical arc length (no dissipation switch) on the softening bar without
+    snap-back (δ_f = 0.03: softening compliance 0.029 > c_e = 0.01)."""
+    df = 0.03
+    pts, _ = _trace("arc_length", df, dissipation=False)
+    _check_on_analytic_path(pts, df)
+    lam = np.array([p[0] for p in pts])
+    assert lam.max() <= 1.0 + 1e-9
+    assert _corner(pts) == pytest.approx(1.0, rel=1e-6)  # the analytic limit point λ = F_p / F̂
+    assert lam[-1] <= 1e-3 * lam.max()  # traced to complete separation
+    assert {p[3] for p in pts} == {"arc"}
+
+
+def test_dissipation_control_traces_the_snap_back():
+    """Snap-back (δ_f = 0.006: c_e = 0.01 > (δ_f − δ0)/F_p = 0.005): the dissipation-based
+    constraint takes over at the peak and traces the branch on which the end displacement
+    u_L decreases with the load down to complete separation; Σ ΔG = ½ F_p δ_f."""
+    df = 0.006
+    pts, _ = _trace("arc_length", df, dissipation=True)
+    _check_on_analytic_path(pts, df)
+    lam = np.array([p[0] for p in pts])
+    d = np.array([p[1] for p in pts])
+    ul = np.array([p[2] for p in pts])
+    i = int(np.argmax(lam))
+    assert lam[i] <= 1.0 + 1e-9
+    assert _corner(pts) == pytest.approx(1.0, rel=1e-6)
+    assert np.all(np.diff(d[i:]) >= -1e-12)  # the crack only opens
+    assert np.all(np.diff(ul[i:]) <= 1e-12)  # snap-back: the loaded end moves back
+    assert ul[i] - ul[-1] == pytest.approx((C_E - (df - D0) / FP) * lam[i], rel=0.01)
+    assert lam[-1] <= 1e-3 * lam.max()
+    assert "dissipation" in {p[3] for p in pts}
+    G = sum(p[4] for p in pts)
+    assert G == pytest.approx(0.5 * FP * df, rel=0.01)
+    assert all(p[4] >= -1e-12 for p in pts)
+
+
+def test_arc_length_on_a_geometrically_nonlinear_cantilever_matches_load_control():
+    """Stable branch: the arc-length path of the large-deflection cantilever passes through the
+    load-controlled solutions (every traced point solved again under load control at its λ
+    stays where it is) and ends exactly at λ_end with the load-controlled answer."""
+    from layershell.solver.arclength import PathSettings, path_steps
+    from layershell.solver.newton import newton
+
+    fs = _spec(FORCE_TIP.format(P=0.15), True, 4)
+    rf = run(fs)
+    pb = Problem.build(fs.model)
+    ps = PathSettings(control="arc_length", lambda_end=1.0, increment=0.25)
+    pts = list(path_steps(pb, fs.newton, ps))
+    assert pts[-1].load_factor == 1.0 and pts[-1].state.finished
+    assert np.allclose(pts[-1].u, rf.u, rtol=0, atol=1e-8 * abs(rf.u).max())
+    lams = [p.load_factor for p in pts]
+    assert np.all(np.diff(lams) > 0)
+    for p in pts[:-1]:
+        pb2 = Problem.build(fs.model)
+        u2, res = newton(pb2, p.u, p.load_factor, fs.newton)
+        assert res.converged and res.iterations <= 1
+        assert np.allclose(u2, p.u, rtol=0, atol=1e-8 * abs(rf.u).max())
+
+
+ARC_STEPS = 'control = "arc_length"\nmax_steps = 40'
+
+
+def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
+    """[steps] control = 'arc_length' through the runner; a run interrupted after step 2 and
+    restarted from its checkpoint (arc length, last increment, λ) ends with the same steps and
+    displacements as an uninterrupted run."""
+    spec = _spec(FORCE_TIP.format(P=0.15), True, 4, ARC_STEPS)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    assert full.converged
+    lams = [s["load_factor"] for s in full.summary["steps"]]
+    assert lams[-1] == 1.0 and len(lams) >= 3 and full.summary["path_end"] == "lambda_end"
+
+    def stop(i, n, lam):
+        if i == 2:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted and len(part.summary["steps"]) == 2
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged
+    assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-12)
+    assert [s["iterations"] for s in again.summary["steps"]] == [s["iterations"] for s in full.summary["steps"]]
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
+
+
+def test_arc_length_without_a_scaled_load_is_bad_input():
+    from layershell.io.build import InputError
+
+    with pytest.raises(InputError, match="steps.control"):
+        _spec(DISP_TIP.format(w=1.0), False, 4, ARC_STEPS)
+    with pytest.raises(InputError, match="steps.factors"):
+        _spec(FORCE_TIP.format(P=0.1), False, 4, ARC_STEPS + "\nfactors = [0.5, 1.0]")
+
+
+def test_adaptive_steps_reach_the_end_in_fewer_steps():
+    """Automatic step size on the large-deflection cantilever (w/l ≈ 0.7): from the same first
+    increment (1/20) it reaches λ = 1 in fewer steps and Newton iterations than 20 fixed steps,
+    with the same answer."""
+    res = {}
+    for key, extra in (("fixed", ""), ("adaptive", "adaptive = true")):
+        r = run(_spec(FORCE_TIP.format(P=0.5), True, 20, extra))
+        assert r.converged
+        st = r.summary["steps"]
+        res[key] = (len(st), sum(s["iterations"] for s in st), r.summary["probes"]["w"], st[-1]["load_factor"])
+    assert res["fixed"][0] == 20
+    assert res["adaptive"][3] == 1.0
+    assert res["adaptive"][0] <= 10 and res["adaptive"][1] < res["fixed"][1]
+    assert res["adaptive"][2] == pytest.approx(res["fixed"][2], rel=1e-9)
+
+
+def test_jump_warnings_unit():
+    from layershell.solver.arclength import jump_warnings
+
+    assert jump_warnings(3, 0.75, 0.5, 0.30, 0.05, None, None, 0.2, 3.0)  # 25 % of the interface at once
+    assert not jump_warnings(3, 0.75, 0.5, 0.20, 0.05, None, None, 0.2, 3.0)
+    # a probe 5× larger while λ grew 1.5× (5 > 3 · 1.5): a jump; 4× while λ grew 2× (4 < 3 · 2): none
+    assert jump_warnings(3, 0.75, 0.5, None, None, {"w": 5.0}, {"w": 1.0}, 0.2, 3.0)
+    assert not jump_warnings(3, 1.0, 0.5, None, None, {"w": 4.0}, {"w": 1.0}, 0.2, 3.0)
+    assert not jump_warnings(3, 0.75, 0.5, None, None, {"w": 4.0}, {"w": 0.0}, 0.2, 3.0)  # from zero: no ratio
+    assert not jump_warnings(3, 0.75, 0.5, 0.9, 0.0, {"w": 40.0}, {"w": 1.0}, None, None)  # switched off
+
+
+@pytest.mark.slow
+def test_debonding_jump_is_warned_and_cut():
+    """§5.1 plate with strong friction, 3 × 3: 4 fixed steps debond 27.8 % of the interface in
+    one step - a warning in summary.json; adaptive steps cut that step (5 halvings, to
+    Δλ = 1/128) and, as the jump stays (the stress criterion releases the zone at once), accept it
+    with the warning at the onset load."""
+    import warnings
+
+    from helpers import run_example
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = run_example("cantilever_plate_strong", {"n = 24": "n = 4"})
+    assert r.converged
+    w = r.summary["warnings"]
+    assert len(w) == 1 and "step 3" in w[0] and "27.8 %" in w[0]
+    assert any("debonded area jumped" in str(c.message) for c in caught)  # on the console too
+    r = run_example("cantilever_plate_strong", {"n = 24": "n = 4\nadaptive = true"})
+    assert r.converged and r.summary["steps"][-1]["load_factor"] == 1.0
+    w = r.summary["warnings"]
+    assert len(w) == 1
+    lam_jump = float(w[0].split("λ = ")[1].split(")")[0])
+    assert 0.5 < lam_jump < 0.5 + 0.25 / 2**4  # cut down near the onset (between 0.5 and 0.75)
+
+
+def test_displacement_control_restart(tmp_path):
+    """A displacement-controlled run stopped after step 2 and restarted ends where the
+    uninterrupted run ends (the prescribed part of u is imposed again at every load factor)."""
+    spec = _spec(DISP_TIP.format(w=3.0), True, 4)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+
+    def stop(i, n, lam):
+        if i == 2:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged and full.converged
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
+    assert again.summary["probes"]["w"] == pytest.approx(3.0, rel=1e-12)
