@@ -473,7 +473,7 @@ def test_figures_that_cannot_be_drawn_are_a_warning_not_an_error(tmp_path, monke
     assert res.converged
     s = json.loads((tmp_path / "out" / "summary.json").read_text())
     assert len(s["warnings"]) == 1 and "figures could not be drawn" in s["warnings"][0]
-    assert "Axis limits" in s["warnings"][0] and s["probes"]["w_tip"] == pytest.approx(4.01246, rel=1e-5)
+    assert "Axis limits" in s["warnings"][0] and s["probes"]["w_tip"] == pytest.approx(4.02045, rel=1e-5)  # MITC9 (full element: 4.01246)
     assert "warning: the figures could not be drawn" in (tmp_path / "out" / "run.log").read_text()
 
 
