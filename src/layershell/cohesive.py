@@ -207,9 +207,10 @@ def separation_measures(delta: np.ndarray, n: np.ndarray):
 
 
 def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float, law: CohesiveLaw,
-                   tangent: bool = True):
+                   tangent: bool = True, with_dd: bool = False):
     """Traction t (..., 3), damage d (...) and the consistent tangent dt/dδ (..., 3, 3) of the
-    cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``."""
+    cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``.
+    ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow)."""
     dn, ds, lam, B, dlam, dB = separation_measures(delta, n)
     dt, dd_l, dd_B = damage_trial(lam, B, K, law)
     loading = dt > d_old
@@ -225,7 +226,7 @@ def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float
     D = K * eye - (K * d)[..., None, None] * dg
     dd = (dd_l[..., None] * dlam + dd_B[..., None] * dB) * loading[..., None]
     D = D - K * g[..., :, None] * dd[..., None, :]
-    return t, d, D
+    return (t, d, D, dd) if with_dd else (t, d, D)
 
 
 def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.ndarray:
@@ -249,3 +250,94 @@ def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.n
     lam = 0.5 * (lo + hi)
     W = 0.5 * K * l0**2 + K * l0 * lc * (1.0 - np.exp(-(lam - l0) / lc))
     return np.where(d > 0, W - 0.5 * (1.0 - d) * K * lam**2, 0.0)
+
+
+# ---------------------------------------------------------------------- interface block
+@dataclass
+class CohesiveBlock:
+    """Element-like block of one cohesive interface: the layers on both sides keep their own
+    DOFs (no bond constraint) and are coupled by the cohesive tractions at the face points.
+
+    Kinematics, DOFs and weights are those of :class:`~layershell.contact.ContactBlock` (its
+    relative displacement Δu = C U (4.43)-(4.44), its normal A3 and its friction return
+    mapping), built on the chosen face rule. The sparsity pattern is fixed (every element's
+    full matrix), so the block is element-like. The tangent is not symmetric where the damage
+    grows (K g ⊗ ∂d/∂δ)."""
+
+    contact: object  # ContactBlock (kinematics, friction state: cap, g_p, alpha_T)
+    law: CohesiveLaw
+    K: float
+    d_old: np.ndarray  # (e, q) converged damage (history variable)
+    symmetric = False
+    compact_tangent = False
+
+    # the attributes that assembly / results read from a block
+    @property
+    def dofs(self) -> np.ndarray:
+        return self.contact.dofs
+
+    @property
+    def w(self) -> np.ndarray:
+        return self.contact.w
+
+    # read by results, probes, plots (as from a ContactBlock)
+    itf = property(lambda self: self.contact.itf)
+    conn = property(lambda self: self.contact.conn)
+    region = property(lambda self: self.contact.region)
+    w0 = property(lambda self: self.contact.w0)
+    X0 = property(lambda self: self.contact.X0)
+
+    @property
+    def released(self) -> np.ndarray:
+        """Fully damaged points (e, q)."""
+        return self.d_old >= FULL_DAMAGE
+
+    def separation(self, u_full: np.ndarray) -> np.ndarray:
+        """Δu (e, q, 3) at the face points."""
+        ne, nq, nk = self.contact.c.shape
+        return np.matmul(self.contact.c, u_full[self.dofs].reshape(ne, nk, 3))
+
+    def point_state(self, u_full: np.ndarray, with_dd: bool = False):
+        """(δ, t, d, D[, ∂d/∂δ]) of the cohesive law at every face point."""
+        delta = self.separation(u_full)
+        out = point_response(delta, self.contact.A3, self.d_old, self.K, self.law, True, with_dd)
+        return (delta, *out)
+
+    def tractions(self, u_full: np.ndarray):
+        """Total traction (cohesive + friction on the damaged share) t (e, q, 3), the cohesive
+        part, the friction part and the damage d (e, q)."""
+        delta, t, d, _ = self.point_state(u_full)
+        tf = np.zeros_like(t)
+        if self.contact.cap is not None and np.any(self.contact.cap > 0):
+            tf, _ = self.contact.friction_traction(u_full, delta)
+        return t + d[..., None] * tf, t, tf, d
+
+    def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False):
+        """Internal force (e, m) and tangent (e, m, m): f_(k,i) = Σ_q c_qk w_q T_qi and
+        K_(k,i)(l,j) = Σ_q c_qk c_ql w_q D_qij (C = c ⊗ I₃, as in ContactBlock.response)."""
+        cb = self.contact
+        ne, nq, nk = cb.c.shape
+        delta, t, d, D, dd = self.point_state(u_full, with_dd=True)
+        T = t
+        friction = cb.cap is not None and np.any(cb.cap > 0)
+        if friction:
+            tf, Df = cb.friction_traction(u_full, delta)
+            T = t + d[..., None] * tf
+        f = np.matmul(cb.c.transpose(0, 2, 1), cb.w[..., None] * T).reshape(ne, 3 * nk)
+        if not tangent:
+            return f, None
+        M = D
+        if friction:
+            M = M + d[..., None, None] * Df + tf[..., :, None] * dd[..., None, :]
+        M = cb.w[..., None, None] * M
+        c = cb.c
+        cM = (c[:, :, None, :, None] * M[:, :, :, None, :]).reshape(ne, nq, 9 * nk)
+        K = np.matmul(c.transpose(0, 2, 1), cM).reshape(ne, 3 * nk, 3 * nk)
+        return f, K
+
+    def elastic_energy(self, u_full: np.ndarray) -> float:
+        """Stored energy of the cohesive springs ½K|δ|² - ½dK|<δ_n>n + δ_s|² integrated."""
+        delta, _, d, _ = self.point_state(u_full)
+        dn, ds, lam, _, _, _ = separation_measures(delta, self.contact.A3)
+        psi = 0.5 * self.K * np.einsum("eqi,eqi->eq", delta, delta) - 0.5 * d * self.K * lam**2
+        return float((self.contact.w * psi).sum())

@@ -218,6 +218,14 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     if ctl is not None:
         summary["first_delamination_load_factor"] = None
         summary["debonded_area"] = []
+    # cohesive interfaces (issue 13): energy columns in probes.csv, onset/peak in summary.json
+    energy_names = (["external_work", "strain_energy", "interface_elastic_energy", "dissipated_fracture",
+                     "dissipated_friction", "dissipated_viscous"]
+                    if ctl is not None and ctl.energies(problem, np.zeros(problem.dm.n_full)) is not None else [])
+    if energy_names:
+        summary.update(first_damage_load_factor=None, peak_load_factor=None, energy=None)
+        if ctl.warnings:
+            summary["warnings"] = list(ctl.warnings)
     hash_ = checkpoint.model_hash(spec) if out is not None else ""
     from .plots import ZoneHistory
 
@@ -255,7 +263,7 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     def write_files() -> None:
         summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
         write_json(out / "summary.json", summary)
-        write_csv(out / "probes.csv", ["step", "load_factor", "iterations"] + names, rows)
+        write_csv(out / "probes.csv", ["step", "load_factor", "iterations"] + names + energy_names, rows)
         if ctl is not None:
             write_delamination_table(out / "delamination.csv", summary["steps"])
 
@@ -289,10 +297,17 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
                     summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,
                                                      **rec["debonded_area"]})
                     summary["first_delamination_load_factor"] = ctl.first_failure()
+                energy = ctl.energies(problem, u) if energy_names else None
+                if energy is not None:
+                    rec["energy"] = energy
+                    summary["energy"] = energy
+                    summary["first_damage_load_factor"] = ctl.first_damage()
+                    summary["peak_load_factor"] = max(float(st.load_factor), summary["peak_load_factor"] or 0.0)
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals
-                rows.append([st.step, st.load_factor, st.iterations] + [vals[n] for n in names])
+                rows.append([st.step, st.load_factor, st.iterations] + [vals[n] for n in names]
+                            + ([energy[k] for k in energy_names] if energy_names else []))
                 if out is not None:
                     if pvd is not None and (st.step % spec.output.every == 0 or st.step == n_steps):
                         from .export import export_step
