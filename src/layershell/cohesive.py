@@ -124,6 +124,13 @@ def onset(B: np.ndarray, K: float, law: CohesiveLaw) -> tuple[np.ndarray, np.nda
     hi = np.where(cs > 0, np.minimum(hi, S / (K * np.maximum(cs, 1e-300))), hi)  # g(S/(K cs)) >= 0
     lo = np.zeros_like(B)
     lam = 0.5 * (lo + hi)
+    with np.errstate(all="ignore"):
+        return _onset_thesis(B, K, law, cn, cs, lo, hi, lam)
+
+
+def _onset_thesis(B, K, law, cn, cs, lo, hi, lam):
+    """Safeguarded Newton for the thesis's onset (see :func:`onset`)."""
+    N, S, p = law.sigma_max, law.tau_max, law.p
     for _ in range(60):
         base = np.clip(1.0 - K * lam * cn / N, 0.0, None)
         g = K * lam * cs - S * base ** (1.0 / p)
@@ -207,22 +214,37 @@ def separation_measures(delta: np.ndarray, n: np.ndarray):
 
 
 def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float, law: CohesiveLaw,
-                   tangent: bool = True, with_dd: bool = False):
+                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None):
     """Traction t (..., 3), damage d (...) and the consistent tangent dt/dδ (..., 3, 3) of the
     cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``.
-    ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow)."""
+    ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow). ``frozen``:
+    (tension, loading) masks that replace δ_n > 0 and d_trial > d_old (an active-set iteration:
+    the response is then smooth; the caller checks the sets after convergence)."""
     dn, ds, lam, B, dlam, dB = separation_measures(delta, n)
+    if frozen is not None:  # λ, B and their derivatives with the frozen tension state
+        tension, loading_f = frozen
+        dnp = np.where(tension, dn, 0.0)
+        lam2 = dnp**2 + np.einsum("...i,...i->...", ds, ds)
+        lam = np.sqrt(lam2)
+        pos = lam > 0
+        ls = np.where(pos, lam, 1.0)
+        B = np.where(pos, (lam2 - dnp**2) / np.where(pos, lam2, 1.0), 0.0)
+        gv = dnp[..., None] * n + ds
+        dlam = gv / ls[..., None] * pos[..., None]
+        dB = (2.0 * ds - 2.0 * B[..., None] * gv) / np.where(pos, lam2, 1.0)[..., None] * pos[..., None]
     dt, dd_l, dd_B = damage_trial(lam, B, K, law)
-    loading = dt > d_old
+    loading = dt > d_old if frozen is None or loading_f is None else loading_f
     d = np.where(loading, dt, d_old)
-    g = np.maximum(dn, 0.0)[..., None] * n + ds  # the damageable part of δ
+    # δ_n = 0 counts as tension (the same traction; the tangent of an opening point - a damaged
+    # point that starts at δ_n = 0, e.g. an initial crack at u = 0, then opens in one iteration)
+    tens = dn >= 0 if frozen is None else tension
+    g = np.where(tens, dn, 0.0)[..., None] * n + ds  # the damageable part of δ
     t = K * delta - (K * d)[..., None] * g
     if not tangent:
         return t, d, None
     eye = np.eye(3)
     nn = n[..., :, None] * n[..., None, :]
-    tens = (dn > 0)[..., None, None]
-    dg = np.where(tens, eye, eye - nn)  # ∂g/∂δ
+    dg = np.where(tens[..., None, None], eye, eye - nn)  # ∂g/∂δ
     D = K * eye - (K * d)[..., None, None] * dg
     dd = (dd_l[..., None] * dlam + dd_B[..., None] * dB) * loading[..., None]
     D = D - K * g[..., :, None] * dd[..., None, :]
@@ -268,8 +290,34 @@ class CohesiveBlock:
     law: CohesiveLaw
     K: float
     d_old: np.ndarray  # (e, q) converged damage (history variable)
+    frozen: tuple | None = None  # (tension, loading) during an active-set solve
     symmetric = False
     compact_tangent = False
+
+    # ------------------------------------------------------------------ active set (solver/newton.py)
+    def gap(self, u_full: np.ndarray) -> np.ndarray:
+        """Normal separation δ_n (e, q)."""
+        return np.einsum("eqi,eqi->eq", self.separation(u_full), self.contact.A3)
+
+    def freeze(self, u_full: np.ndarray) -> None:
+        """Fix the tension/compression state of every point for the next Newton iterations
+        (the jump of the normal stiffness of a damaged point at δ_n = 0 is the contact-like
+        non-smoothness; the damage growth d = max(d_old, d_trial) stays semi-smooth)."""
+        self.frozen = None
+        self.frozen = (self.gap(u_full) >= 0, None)
+
+    def set_changed(self, u_full: np.ndarray) -> bool:
+        """Does the frozen tension state still hold at the converged ``u_full`` (where it
+        matters: at damaged points, judged without the frozen state)?"""
+        if self.frozen is None:
+            return False
+        frozen, self.frozen = self.frozen, None
+        _, _, d, _ = self.point_state(u_full)
+        self.frozen = frozen
+        return bool(np.any(((self.gap(u_full) >= 0) != frozen[0]) & (d > 0)))
+
+    def unfreeze(self) -> None:
+        self.frozen = None
 
     # the attributes that assembly / results read from a block
     @property
@@ -300,7 +348,7 @@ class CohesiveBlock:
     def point_state(self, u_full: np.ndarray, with_dd: bool = False):
         """(δ, t, d, D[, ∂d/∂δ]) of the cohesive law at every face point."""
         delta = self.separation(u_full)
-        out = point_response(delta, self.contact.A3, self.d_old, self.K, self.law, True, with_dd)
+        out = point_response(delta, self.contact.A3, self.d_old, self.K, self.law, True, with_dd, self.frozen)
         return (delta, *out)
 
     def tractions(self, u_full: np.ndarray):

@@ -60,6 +60,7 @@ class CohesiveRun:
     t_fric: np.ndarray  # (e, q, 3) friction traction (damaged share) at the last commit
     energy: np.ndarray  # [fracture, friction] dissipated so far (energy)
     first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
+    initial: np.ndarray  # (e, q) points of initially debonded zones
     first_failure: float | None = None  # first point fully debonded
 
     def update(self, u: np.ndarray, lam: float) -> None:
@@ -81,9 +82,10 @@ class CohesiveRun:
         self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum())])
         blk.d_old = d
         self.delta, self.t_fric = delta, tf
-        if np.isnan(self.first_damage) and np.any(d > 0):
+        fresh = ~self.initial  # initially debonded zones do not count as new damage
+        if np.isnan(self.first_damage) and np.any((d > 0) & fresh):
             self.first_damage = np.array(lam, float)
-        if self.first_failure is None and np.any(d >= FULL_DAMAGE):
+        if self.first_failure is None and np.any((d >= FULL_DAMAGE) & fresh):
             self.first_failure = lam
         # --- friction of the next step on the damaged share under compression: the thesis's
         # slip-softening limit (4.76) without its adhesive part τ_Delam(0), which the cohesive law
@@ -476,7 +478,7 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
         d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
     blk = CohesiveBlock(cb, law, K, d0)
     return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(2),
-                       np.array(np.nan))
+                       np.array(np.nan), d0 > 0)
 
 
 def _process_zone_warning(model, r: CohesiveRun) -> list[str]:
@@ -488,8 +490,9 @@ def _process_zone_warning(model, r: CohesiveRun) -> list[str]:
     E = min(lo.material.E3, up.material.E3)
     lcz = r.law.process_zone_length(E)
     X = model.mesh.nodes[cb.conn]  # (e, 9, 3)
-    h = float(np.max(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).tolist()
-                     + np.linalg.norm(X[:, 3] - X[:, 0], axis=-1).tolist())) / 2.0
+    # node spacing: half the shorter side of the largest elements (the front runs along one side)
+    h = 0.5 * min(float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).max()),
+                  float(np.linalg.norm(X[:, 3] - X[:, 0], axis=-1).max()))
     if lcz >= 3.0 * h:
         return []
     return [f"interface '{cb.itf.name}': the cohesive process zone l_cz = E G_c / tau0^2 = {lcz:.4g} "
