@@ -145,3 +145,19 @@ def test_block_tangent_against_finite_differences(rule, friction):
     scale = np.abs(Kr).max()
     np.testing.assert_allclose(Kr, Kfd, atol=1e-7 * scale)
 
+
+
+def test_energy_balance_with_damage():
+    """External work (path integral of λF·du) = strain energy of the layers (path integral of
+    their internal forces) + elastic energy of the cohesive springs + fracture dissipation
+    (closed form of the bilinear law) + friction, within 1 %, along a loading path on which the
+    interface damages (first damage at λ = 0.6, a fifth of the work dissipated)."""
+    spec = strip(nonlinear="false", nx=6, load="0.5", steps=10, cohesive={"smax": 0.3, "tmax": 0.6})
+    s = run(spec, None, write_vtu=False).summary
+    assert s["converged"] and s["first_damage_load_factor"] == pytest.approx(0.6)
+    e = s["energy"]
+    assert e["dissipated_fracture"] > 0.1 * e["external_work"]
+    stored = e["strain_energy"] + e["interface_elastic_energy"]
+    dissipated = e["dissipated_fracture"] + e["dissipated_friction"] + e["dissipated_viscous"]
+    assert abs(e["external_work"] - stored - dissipated) < 0.01 * e["external_work"]
+    assert s["peak_load_factor"] == 1.0
