@@ -161,3 +161,24 @@ def test_energy_balance_with_damage():
     dissipated = e["dissipated_fracture"] + e["dissipated_friction"] + e["dissipated_viscous"]
     assert abs(e["external_work"] - stored - dissipated) < 0.01 * e["external_work"]
     assert s["peak_load_factor"] == 1.0
+
+
+def test_state_round_trip_for_restart():
+    """The interface state (damage, friction, energies) saved for checkpoints and step cutting is
+    restored exactly on a freshly built problem."""
+    spec = strip(nonlinear="false", nx=2, load="0.5", steps=1, cohesive={"smax": 0.3, "tmax": 0.6})
+    pb = Problem.build(spec.model)
+    ctl = pb.interfaces
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=pb.dm.n_full) * 1e-4
+    ctl.update(pb, u, 0.5)
+    state = ctl.state(pb)
+    pb2 = Problem.build(spec.model)
+    pb2.interfaces.restore(pb2, state)
+    r1, r2 = ctl.runs[0], pb2.interfaces.runs[0]
+    assert np.array_equal(r1.block.d_old, r2.block.d_old) and r1.block.d_old.max() > 0
+    assert np.array_equal(r1.energy, r2.energy) and np.array_equal(ctl.energy, pb2.interfaces.energy)
+    assert float(r2.first_damage) == 0.5
+    f1, _ = pb.assembler.evaluate(u, tangent=False)
+    f2, _ = pb2.assembler.evaluate(u, tangent=False)
+    np.testing.assert_array_equal(f1, f2)
