@@ -291,6 +291,13 @@ class CohesiveBlock:
     K: float
     d_old: np.ndarray  # (e, q) converged damage (history variable)
     frozen: tuple | None = None  # (tension, loading) during an active-set solve
+    # viscous regularisation (Gao & Bower 2004), law.viscosity = η > 0: the acting damage d_v
+    # follows the rate-independent d with ḋ_v = (d - d_v)/η in load-factor time, backward Euler
+    # d_v = (d_v,old + r d)/(1 + r), r = Δλ/η (never decreasing)
+    dv_old: np.ndarray | None = None  # (e, q) converged acting damage (= d_old without viscosity)
+    lam_old: float = 0.0  # load factor of the last commit
+    lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
+    last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
     symmetric = False
     compact_tangent = False
 
@@ -345,11 +352,36 @@ class CohesiveBlock:
         ne, nq, nk = self.contact.c.shape
         return np.matmul(self.contact.c, u_full[self.dofs].reshape(ne, nk, 3))
 
+    def set_load_factor(self, lam: float) -> None:
+        """The load factor of the coming solve (pseudo-time of the viscous regularisation)."""
+        self.lam_trial = float(lam)
+
     def point_state(self, u_full: np.ndarray, with_dd: bool = False):
-        """(δ, t, d, D[, ∂d/∂δ]) of the cohesive law at every face point."""
+        """(δ, t, d, D[, ∂d/∂δ]) of the cohesive law at every face point; d is the acting damage
+        (the viscous one where ``law.viscosity`` > 0; the rate-independent one is kept in
+        ``last_inviscid``)."""
         delta = self.separation(u_full)
-        out = point_response(delta, self.contact.A3, self.d_old, self.K, self.law, True, with_dd, self.frozen)
-        return (delta, *out)
+        n = self.contact.A3
+        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen)
+        self.last_inviscid = d
+        if self.law.viscosity > 0:
+            r = max(self.lam_trial - self.lam_old, 0.0) / self.law.viscosity
+            dv_old = self.d_old if self.dv_old is None else self.dv_old
+            dv = (dv_old + r * d) / (1.0 + r)
+            grow = dv > dv_old
+            dv = np.where(grow, dv, dv_old)
+            ddv = np.where(grow[..., None], r / (1.0 + r) * dd, 0.0)
+            # t = Kδ - K d g, D = K I - K d ∂g/∂δ - K g ⊗ ∂d/∂δ: swap d for d_v
+            dn = np.einsum("eqi,eqi->eq", delta, n)
+            tens = dn >= 0 if self.frozen is None else self.frozen[0]
+            g = np.where(tens, dn, 0.0)[..., None] * n + (delta - dn[..., None] * n)
+            nn = n[..., :, None] * n[..., None, :]
+            dg = np.where(tens[..., None, None], np.eye(3), np.eye(3) - nn)
+            t = t + (self.K * (d - dv))[..., None] * g
+            D = (D + (self.K * (d - dv))[..., None, None] * dg
+                 + self.K * g[..., :, None] * (dd - ddv)[..., None, :])
+            d, dd = dv, ddv
+        return (delta, t, d, D, dd) if with_dd else (delta, t, d, D)
 
     def tractions(self, u_full: np.ndarray):
         """Total traction (cohesive + friction on the damaged share) t (e, q, 3), the cohesive

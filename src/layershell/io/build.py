@@ -469,7 +469,7 @@ def _cohesive_law(idf, f: str, gT: float, model, upper: int, lower: int):
                          "area in the model's units, e.g. kN/m for kN, m): add them to the interface, e.g. from a "
                          "DCB (G_Ic) and an ENF or shear bond test (G_IIc)")
     law = CohesiveLaw(idf.G_Ic, idf.G_IIc, idf.sigma_max, idf.tau_max, idf.eta, idf.p, idf.onset, idf.softening,
-                      idf.K0, idf.alpha, 0.0, idf.mu0, idf.mu, gT, idf.mu_coulomb, idf.alpha_T, idf.rule)
+                      idf.K0, idf.alpha, idf.viscosity, idf.mu0, idf.mu, gT, idf.mu_coulomb, idf.alpha_T, idf.rule)
     try:
         law.check(f)
     except ValueError as exc:

@@ -400,6 +400,10 @@ class InterfaceDef(Strict):
         None, description="cohesive: initial penalty stiffness per area in the normal and tangential directions "
                           "(stress/length; default alpha · E3/H of the thinner adjacent layer, Turon et al. 2007)")
     alpha: PositiveFloat = Field(50.0, description="cohesive: factor α of the default K0 = α E3/H")
+    viscosity: float = Field(
+        0.0, ge=0, description="cohesive: viscous regularisation time η in load-factor units (Gao & Bower 2004; 0 = "
+                               "off): the damage follows the rate-independent one with ḋ = (d_inviscid - d)/η; its "
+                               "extra dissipation is reported as dissipated_viscous")
     rule: Literal["lobatto", "gauss"] = Field(
         "lobatto", description="cohesive: interface integration at the nodes (Lobatto/Newton–Cotes, default) or at the "
                                "3×3 Gauss points (tractions oscillate with stiff penalties, Schellekens & de Borst 1993)")

@@ -58,20 +58,28 @@ class CohesiveRun:
     gmax: np.ndarray  # (e, q) largest tangential separation so far (slip softening (4.76))
     delta: np.ndarray  # (e, q, 3) separation at the last commit
     t_fric: np.ndarray  # (e, q, 3) friction traction (damaged share) at the last commit
-    energy: np.ndarray  # [fracture, friction] dissipated so far (energy)
+    energy: np.ndarray  # [fracture, friction, viscous] dissipated so far (energy)
     first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
     initial: np.ndarray  # (e, q) points of initially debonded zones
+    Y: np.ndarray  # (e, q) damage driving force ½Kλ² at the last commit (viscous dissipation)
     first_failure: float | None = None  # first point fully debonded
 
     def update(self, u: np.ndarray, lam: float) -> None:
         """Commit the converged state: damage, dissipated energies, friction limit of the next step."""
         blk, cb, law = self.block, self.block.contact, self.law
+        blk.set_load_factor(lam)
         delta, t, d, _ = blk.point_state(u)
-        _, ds, _, B, _, _ = separation_measures(delta, cb.A3)
+        d_inv = blk.last_inviscid
+        _, ds, lam_eq, B, _, _ = separation_measures(delta, cb.A3)
         w = cb.w
-        grow = d > blk.d_old
+        d_prev = blk.dv_old if blk.dv_old is not None else blk.d_old  # acting damage of the last commit
+        grow = d > d_prev
         # fracture: closed-form dissipation between the old and the new damage at the current mode ratio
-        frac = np.where(grow, dissipated(d, B, blk.K, law) - dissipated(blk.d_old, B, blk.K, law), 0.0)
+        frac = np.where(grow, dissipated(d, B, blk.K, law) - dissipated(d_prev, B, blk.K, law), 0.0)
+        # viscous regularisation: the work of the damage driving force Y = ½Kλ² on the damage
+        # increment (trapezoid) beyond the closed form of the rate-independent law
+        Y = 0.5 * blk.K * lam_eq**2
+        visc = (np.where(grow, 0.5 * (self.Y + Y) * (d - d_prev), 0.0) - frac) if law.viscosity > 0 else 0.0 * Y
         tf = np.zeros_like(t)
         if cb.cap is not None and np.any(cb.cap > 0):
             tf, _ = cb.friction_traction(u, delta)
@@ -79,8 +87,9 @@ class CohesiveRun:
         P = cb.projector()
         dslip = np.einsum("eqij,eqj->eqi", P, delta - self.delta)
         fric = 0.5 * np.einsum("eqi,eqi->eq", self.t_fric + tf, dslip)
-        self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum())])
-        blk.d_old = d
+        self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum()),
+                                              float((w * visc).sum())])
+        blk.d_old, blk.dv_old, blk.lam_old, self.Y = d_inv, d, float(lam), Y
         self.delta, self.t_fric = delta, tf
         fresh = ~self.initial  # initially debonded zones do not count as new damage
         if np.isnan(self.first_damage) and np.any((d > 0) & fresh):
@@ -322,6 +331,8 @@ class InterfaceController:
                     out[f"run{i}.block.{name}"] = np.array(value, copy=True)
             if isinstance(r, CohesiveRun):
                 out[f"run{i}.block.d_old"] = np.array(r.block.d_old, copy=True)
+                out[f"run{i}.block.dv_old"] = np.array(r.block.dv_old, copy=True)
+                out[f"run{i}.block.lam_old"] = np.array(r.block.lam_old, float)
         out["energy"] = np.array(self.energy, copy=True)
         if self.u_last is not None:
             out["energy.u"], out["energy.f"] = self.u_last.copy(), self.f_last.copy()
@@ -360,6 +371,8 @@ class InterfaceController:
                     setattr(_kin(r.block), name, take(f"run{i}.block.{name}", getattr(_kin(r.block), name)))
             if isinstance(r, CohesiveRun):
                 r.block.d_old = take(f"run{i}.block.d_old", r.block.d_old)
+                r.block.dv_old = take(f"run{i}.block.dv_old", r.block.dv_old)
+                r.block.lam_old = float(take(f"run{i}.block.lam_old", None))
             _kin(r.block).active = None
         if "energy" in state:
             self.energy = np.array(state["energy"], float)
@@ -428,7 +441,7 @@ class InterfaceController:
         E_itf = sum(r.block.elastic_energy(u) for r in coh)
         frac = sum(float(r.energy[0]) for r in coh)
         fric = sum(float(r.energy[1]) for r in coh)
-        visc = 0.0
+        visc = sum(float(r.energy[2]) for r in coh)
         err = W - U - E_itf - frac - fric - visc
         return {"external_work": W, "strain_energy": U, "interface_elastic_energy": E_itf,
                 "dissipated_fracture": frac, "dissipated_friction": fric, "dissipated_viscous": visc,
@@ -476,9 +489,9 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
         init = np.zeros(model.mesh.n_nodes, bool)
         init[initial_nodes] = True
         d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
-    blk = CohesiveBlock(cb, law, K, d0)
-    return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(2),
-                       np.array(np.nan), d0 > 0)
+    blk = CohesiveBlock(cb, law, K, d0, dv_old=d0.copy())
+    return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
+                       np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
 
 
 def _process_zone_warning(model, r: CohesiveRun) -> list[str]:

@@ -75,6 +75,9 @@ class Problem:
         self.interfaces.resolves = snap["resolves"]  # re-solutions so far in this load step
 
     def external(self, lam: float) -> np.ndarray:
+        for b in self.extra_blocks:  # rate-dependent blocks (viscous cohesive law) need λ
+            if hasattr(b, "set_load_factor"):
+                b.set_load_factor(lam)
         F = lam * self.F_scaled + self.F_const
         return F if self.F_friction is None else F + self.F_friction
 
