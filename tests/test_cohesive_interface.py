@@ -200,3 +200,13 @@ def test_viscous_regularisation_reports_its_dissipation():
     assert visc["converged"] and e["dissipated_viscous"] > 0
     assert e["dissipated_fracture"] < plain["energy"]["dissipated_fracture"]
     assert abs(e["balance_error"]) < 0.01
+
+
+def test_process_zone_warning():
+    """l_cz = E G_c / τ0² (Turon et al. 2007) against the node spacing (strip: 12.5 mm elements,
+    6.25 mm node spacing): strengths of 1 N/mm² give l_cz = 30000 × 0.5 / 1 = 15 km (no warning),
+    strengths of 1000 N/mm² give 15 mm = 2.4 spacings (warning naming the interface)."""
+    ok = run(strip(nx=8, cohesive={"smax": 1.0, "tmax": 1.0}), None, write_vtu=False).summary
+    assert "warnings" not in ok
+    bad = run(strip(nx=8, cohesive={"smax": 30.0, "tmax": 30.0}), None, write_vtu=False).summary
+    assert len(bad["warnings"]) == 1 and "lower/upper" in bad["warnings"][0] and "2.67 node spacings" in bad["warnings"][0]
