@@ -50,10 +50,22 @@ def friction_shape_inverse(ratio: np.ndarray | float):
     return ratio / (1.0 - ratio**k) ** (1.0 / k)
 
 
-def point_regions() -> np.ndarray:
-    """Element node (VTK order) whose region contains each 3×3 face Gauss point (§9 rule 1:
-    the nearest node)."""
-    pts, _ = gauss_2d(3)
+def face_rule(rule: str = "gauss") -> tuple[np.ndarray, np.ndarray]:
+    """Interface integration rule on the element face: the 3×3 Gauss points (the thesis's face
+    points (3.48)) or the 3×3 Lobatto (nodal Newton–Cotes/Simpson) rule, whose points are the
+    nodes (no traction oscillations with stiff interface penalties, Schellekens & de Borst 1993).
+    Points (9, 2) eta-major as :func:`gauss_2d`, weights (9,)."""
+    if rule == "gauss":
+        return gauss_2d(3)
+    x, w = np.array([-1.0, 0.0, 1.0]), np.array([1.0, 4.0, 1.0]) / 3.0
+    xi, eta = np.meshgrid(x, x, indexing="xy")
+    return np.stack([xi.ravel(), eta.ravel()], axis=-1), np.outer(w, w).ravel()
+
+
+def point_regions(rule: str = "gauss") -> np.ndarray:
+    """Element node (VTK order) whose region contains each 3×3 face point (§9 rule 1: the
+    nearest node; for the nodal rule the node itself)."""
+    pts, _ = face_rule(rule)
     sgn = np.sign(np.round(pts, 12))
     return np.array([int(np.flatnonzero((NODE_XI == s).all(1))[0]) for s in sgn])
 
@@ -100,10 +112,11 @@ class ContactBlock:
             self.c = np.ascontiguousarray(self.C[:, :, 0, 0::3])
 
     @classmethod
-    def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float) -> "ContactBlock":
+    def build(cls, model: Model, dm: DofMap, itf: Interface, alpha: float, rule: str = "gauss") -> "ContactBlock":
+        """``rule``: the face points (:func:`face_rule`); the thesis's contact uses "gauss"."""
         el = itf.elements
         conn = model.mesh.elements[el]
-        pts, wq = gauss_2d(3)
+        pts, wq = face_rule(rule)
         sp = surface_points(model.mesh.nodes[conn], pts[:, 0], pts[:, 1])
         lo = model.layers[itf.lower]
         d = lo.directors
@@ -120,7 +133,7 @@ class ContactBlock:
         b = np.einsum("eqi,eqim->eqm", sp.A3, C)
         dofs = np.concatenate([dm.layer_dofs[itf.upper][conn][:, :, 0, :].reshape(ne, -1),
                                dm.layer_dofs[itf.lower][conn].reshape(ne, -1)], axis=1)
-        return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(), alpha,
+        return cls(itf, conn, dofs, C, b, sp.A3, detG[..., 0] * wq, sp.sqrtA * wq, point_regions(rule), alpha,
                    np.zeros((ne, nq), bool), X0=sp.X0, c=c)
 
     # ------------------------------------------------------------------ kinematics

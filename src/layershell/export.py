@@ -247,7 +247,16 @@ def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None, 
     ne = itf.elements.size
     point_data = {"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
                   "shear": np.hypot(tm[:, 0], tm[:, 1]), "displacement": ps.u}
-    if run is not None:
+    if run is not None and hasattr(run.block, "d_old"):  # cohesive interface (issue 13)
+        inv = np.argsort(run.block.region)
+        pick = lambda a: a[:, inv].reshape(ne * 9, *a.shape[2:])  # noqa: E731
+        delta = run.block.separation(u_full)
+        n = run.block.contact.A3
+        gap = np.einsum("eqi,eqi->eq", delta, n)
+        slip = delta - gap[..., None] * n
+        point_data.update({"damage": pick(run.block.d_old), "debonded": pick(run.block.released.astype(np.int8)),
+                           "gap": pick(gap), "slip": pick(slip), "slip_magnitude": pick(np.linalg.norm(slip, axis=-1))})
+    elif run is not None:
         # delamination state lives at the 9 face Gauss points; each belongs to exactly one node
         # region (MODEL.md §9 rule 1), so it maps one-to-one onto the element's nodes
         inv = np.argsort(run.block.region)

@@ -159,6 +159,7 @@ class Recorder:
         self._probes: AppendCsv | None = None
         self._delam: AppendCsv | None = None
         self._delam_names: list[str] | None = None
+        self.energy_names: list[str] = []
         self._summary_t = -1e300  # time of the last summary.json write
         self._summary_cost = 0.0
         self._sync_t = -1e300  # time of the last fsync of the checkpoint
@@ -277,23 +278,28 @@ class Recorder:
 
     # ----------------------------------------------------------------- per-step results
 
-    def begin(self, probe_names: list[str], history: list[dict]) -> None:
+    def begin(self, probe_names: list[str], history: list[dict], energy_names: list[str] = ()) -> None:
         """Take over the folder (the earlier run's files go now) and start the per-step files
-        with ``history`` (the steps before a restart, else empty)."""
+        with ``history`` (the steps before a restart, else empty). ``energy_names``: columns of
+        probes.csv after the probes, taken from each step's ``energy`` (cohesive interfaces)."""
         self._start()
         self.probe_names = list(probe_names)
+        self.energy_names = list(energy_names)
         lines = "".join(json.dumps(r) + "\n" for r in history)
         atomic_write(self.path(STEPS), lambda tmp: tmp.write_text(lines, encoding="utf-8"))
         self._steps = open(self.folder / STEPS, "a", encoding="utf-8")
         self._register("probes.csv")
-        self._probes = AppendCsv(self.folder / "probes.csv", ["step", "load_factor", "iterations"] + self.probe_names,
+        self._probes = AppendCsv(self.folder / "probes.csv",
+                                 ["step", "load_factor", "iterations"] + self.probe_names + self.energy_names,
                                  [self._row(r) for r in history])
         recs = [r for r in history if "debonded_extent" in r]
         if recs:
             self._start_delam(recs)
 
     def _row(self, rec: dict) -> list:
-        return [rec["step"], rec["load_factor"], rec["iterations"]] + [rec["probes"][n] for n in self.probe_names]
+        energy = rec.get("energy") or {}
+        return ([rec["step"], rec["load_factor"], rec["iterations"]] + [rec["probes"][n] for n in self.probe_names]
+                + [energy.get(n, "") for n in self.energy_names])
 
     _DELAM_KEYS = ("area", "x_min", "x_max", "y_min", "y_max")
 

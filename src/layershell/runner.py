@@ -200,6 +200,10 @@ class _JumpWatch:
         self.lam, self.probes, self.frac = st.load_factor, probes, frac
 
 
+class CohesiveWarning(UserWarning):
+    """A cohesive interface whose model is doubtful (e.g. an unresolved process zone)."""
+
+
 class JumpWarning(UserWarning):
     """A step with a jump of the debonded area or of a probe."""
 
@@ -318,6 +322,18 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     if ctl is not None:
         summary["first_delamination_load_factor"] = None
         summary["debonded_area"] = []
+    # cohesive interfaces (issue 13): energy columns in probes.csv, onset/peak in summary.json
+    energy_names = (["external_work", "strain_energy", "interface_elastic_energy", "dissipated_fracture",
+                     "dissipated_friction", "dissipated_viscous"]
+                    if ctl is not None and ctl.energies(problem, np.zeros(problem.dm.n_full)) is not None else [])
+    if energy_names:
+        summary.update(first_damage_load_factor=None, peak_load_factor=None, energy=None)
+        if ctl.warnings:  # e.g. a process zone covered by fewer than 3 node spacings: console and summary.json
+            import warnings as _w
+
+            summary.setdefault("warnings", []).extend(ctl.warnings)
+            for m in ctl.warnings:
+                _w.warn(m, CohesiveWarning, stacklevel=2)
     from .plots import ZoneHistory
 
     zones = ZoneHistory(ctl, keep=spec.output.zone_steps)  # debonded flags of the steps the zone maps may show
@@ -355,7 +371,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if r.get("files"):
                         r["files"] = {k: _rebase([(0.0, f)], base, out)[0][1] for k, f in r["files"].items()}
     if rcd is not None:
-        rcd.begin(names, history)
+        rcd.begin(names, history, energy_names)
         if pvd is not None:
             pvd.write()
             rcd.register([f"{k}.pvd" for k in pvd.series])
@@ -450,6 +466,12 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if getattr(st, "end", None):
                         summary["path_end"] = st.end  # lambda_end, complete failure or max_steps
                 jumps.check(st, vals, rec.get("debonded_area"), ctl)
+                energy = ctl.energies(problem, u) if energy_names else None
+                if energy is not None:
+                    rec["energy"] = energy
+                    summary["energy"] = energy
+                    summary["first_damage_load_factor"] = ctl.first_damage()
+                    summary["peak_load_factor"] = max(float(st.load_factor), summary["peak_load_factor"] or 0.0)
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals

@@ -615,6 +615,39 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
     return [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for c in cs for e in dirs]
 
 
+def _cohesive_law(idf, f: str, gT: float, model, upper: int, lower: int):
+    """CohesiveLaw of ``[[interfaces]] law = "cohesive"`` with its input checks (issue 13)."""
+    from ..cohesive import CohesiveLaw
+    from ..interfaces import Interface
+    from ..solver.interface_state import cohesive_softening_estimate, default_cohesive_stiffness
+
+    missing = [k for k in ("G_Ic", "G_IIc") if getattr(idf, k) is None]
+    if missing:
+        raise InputError(f"'{f}': law = \"cohesive\" needs the fracture energies {' and '.join(missing)} (energy per "
+                         "area in the model's units, e.g. kN/m for kN, m): add them to the interface, e.g. from a "
+                         "DCB (G_Ic) and an ENF or shear bond test (G_IIc)")
+    law = CohesiveLaw(idf.G_Ic, idf.G_IIc, idf.sigma_max, idf.tau_max, idf.eta, idf.p, idf.onset, idf.softening,
+                      idf.K0, idf.alpha, idf.viscosity, idf.mu0, idf.mu, gT, idf.mu_coulomb, idf.alpha_T, idf.rule)
+    try:
+        law.check(f)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    itf = Interface(upper, lower, "", np.zeros(0, int))
+    K = law.K0 if law.K0 is not None else default_cohesive_stiffness(model, itf, law)
+    soft = cohesive_softening_estimate(model, itf, K)
+    if soft > 0.03:
+        raise InputError(f"'{f}.K0' = {K:.4g}: this penalty stiffness makes the interface {100 * soft:.3g} % as "
+                         "compliant as the two layers through their thickness, so it softens the bonded structure by "
+                         "more than a few percent; raise K0 (or leave it out for the default alpha · E3/H, Turon et "
+                         "al. 2007)")
+    K_ref = default_cohesive_stiffness(model, itf, replace(law, alpha=1.0))
+    if K > 1e5 * K_ref:
+        raise InputError(f"'{f}.K0' = {K:.4g} is more than 1e5 × E3/H of the adjacent layers ({K_ref:.4g}): such a "
+                         "penalty spoils the conditioning of the equations without changing the result; lower it "
+                         "(or leave it out for the default alpha · E3/H)")
+    return law
+
+
 def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
     """Interface laws, initially debonded zones and delamination settings (MODEL.md §9-§10)."""
     from ..delamination import InterfaceLaw
@@ -635,12 +668,15 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
         if k in model.interface_laws:
             raise InputError(f"'{f}.layer': the interface below '{idf.layer}' is defined twice")
         gT = float("inf") if idf.gT_mu == "inf" else float(idf.gT_mu)
-        law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
-                           idf.alpha_N, idf.alpha_T, idf.open_gap)
-        try:
-            law.check(f)
-        except ValueError as exc:
-            raise InputError(str(exc)) from None
+        if idf.law == "cohesive":
+            law = _cohesive_law(idf, f, gT, model, k, below[k])
+        else:
+            law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
+                               idf.alpha_N, idf.alpha_T, idf.open_gap)
+            try:
+                law.check(f)
+            except ValueError as exc:
+                raise InputError(str(exc)) from None
         model.interface_laws[k] = law
         nodes = []
         zone_law = None

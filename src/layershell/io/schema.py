@@ -548,6 +548,28 @@ class InterfaceDef(Strict):
                           "upper layer's thickness; an addition, the thesis's friction stops at any opening)")
     initially_debonded: list[InitialZone] = Field([], description=(
         "zones debonded from the start: {where | set | circle, mu0, mu, gT_mu}"))
+    law: Literal["thesis", "cohesive"] = Field(
+        "thesis", description="\"thesis\": bond released node by node by the stress criterion (4.15) (MODEL.md §9); "
+                              "\"cohesive\": both layers keep their own DOFs, coupled by a damaging cohesive law "
+                              "with onset by sigma_max/tau_max/p and propagation by G_Ic, G_IIc (issue 13)")
+    G_Ic: float | None = Field(None, description="cohesive: mode I fracture energy (energy per area, e.g. kN/m = N/mm)")
+    G_IIc: float | None = Field(None, description="cohesive: mode II fracture energy (energy per area)")
+    eta: PositiveFloat = Field(2.0, description="cohesive: Benzeggagh–Kenane exponent η of G_c = G_Ic + (G_IIc - G_Ic) B^η")
+    onset: Literal["thesis", "quadratic"] = Field(
+        "thesis", description="cohesive: damage onset by the thesis's criterion (4.15) (sigma_max, tau_max, p) or the "
+                              "quadratic one (σ/sigma_max)² + (τ/tau_max)² = 1")
+    softening: Literal["bilinear", "exponential"] = Field("bilinear", description="cohesive: shape of the softening branch")
+    K0: PositiveFloat | None = Field(
+        None, description="cohesive: initial penalty stiffness per area in the normal and tangential directions "
+                          "(stress/length; default alpha · E3/H of the thinner adjacent layer, Turon et al. 2007)")
+    alpha: PositiveFloat = Field(50.0, description="cohesive: factor α of the default K0 = α E3/H")
+    viscosity: float = Field(
+        0.0, ge=0, description="cohesive: viscous regularisation time η in load-factor units (Gao & Bower 2004; 0 = "
+                               "off): the damage follows the rate-independent one with ḋ = (d_inviscid - d)/η; its "
+                               "extra dissipation is reported as dissipated_viscous")
+    rule: Literal["lobatto", "gauss"] = Field(
+        "lobatto", description="cohesive: interface integration at the nodes (Lobatto/Newton–Cotes, default) or at the "
+                               "3×3 Gauss points (tractions oscillate with stiff penalties, Schellekens & de Borst 1993)")
 
 
 class DelaminationDef(Strict):

@@ -25,8 +25,9 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from ..cohesive import FULL_DAMAGE, CohesiveBlock, CohesiveLaw, dissipated, separation_measures
 from ..contact import ContactBlock, friction_shape_inverse
-from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_slide
+from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_delam, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
 
 
@@ -44,6 +45,78 @@ class InterfaceRun:
     slip: np.ndarray  # (e, q, 3) tangential relative displacement g_T
     pressure: np.ndarray  # (e, q) contact pressure (≤ 0)
     first_failure: float | None = None
+
+
+@dataclass
+class CohesiveRun:
+    """State of one cohesive interface (issue 13): the committed damage is ``block.d_old``;
+    friction on the damaged share under compression uses the contact block's return mapping
+    with a slip limit frozen per step."""
+
+    block: CohesiveBlock
+    law: CohesiveLaw
+    gmax: np.ndarray  # (e, q) largest tangential separation so far (slip softening (4.76))
+    delta: np.ndarray  # (e, q, 3) separation at the last commit
+    t_fric: np.ndarray  # (e, q, 3) friction traction (damaged share) at the last commit
+    energy: np.ndarray  # [fracture, friction, viscous] dissipated so far (energy)
+    first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
+    initial: np.ndarray  # (e, q) points of initially debonded zones
+    Y: np.ndarray  # (e, q) damage driving force ½Kλ² at the last commit (viscous dissipation)
+    first_failure: float | None = None  # first point fully debonded
+
+    def update(self, u: np.ndarray, lam: float) -> None:
+        """Commit the converged state: damage, dissipated energies, friction limit of the next step."""
+        blk, cb, law = self.block, self.block.contact, self.law
+        blk.set_load_factor(lam)
+        delta, t, d, _ = blk.point_state(u)
+        d_inv = blk.last_inviscid
+        _, ds, lam_eq, B, _, _ = separation_measures(delta, cb.A3)
+        w = cb.w
+        d_prev = blk.dv_old if blk.dv_old is not None else blk.d_old  # acting damage of the last commit
+        grow = d > d_prev
+        # fracture: closed-form dissipation between the old and the new damage at the current mode ratio
+        frac = np.where(grow, dissipated(d, B, blk.K, law) - dissipated(d_prev, B, blk.K, law), 0.0)
+        # viscous regularisation: the work of the damage driving force Y = ½Kλ² on the damage
+        # increment (trapezoid) beyond the closed form of the rate-independent law
+        Y = 0.5 * blk.K * lam_eq**2
+        visc = (np.where(grow, 0.5 * (self.Y + Y) * (d - d_prev), 0.0) - frac) if law.viscosity > 0 else 0.0 * Y
+        tf = np.zeros_like(t)
+        if cb.cap is not None and np.any(cb.cap > 0):
+            tf, _ = cb.friction_traction(u, delta)
+        tf = d[..., None] * tf
+        P = cb.projector()
+        dslip = np.einsum("eqij,eqj->eqi", P, delta - self.delta)
+        fric = 0.5 * np.einsum("eqi,eqi->eq", self.t_fric + tf, dslip)
+        self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum()),
+                                              float((w * visc).sum())])
+        blk.d_old, blk.dv_old, blk.lam_old, self.Y = d_inv, d, float(lam), Y
+        self.delta, self.t_fric = delta, tf
+        fresh = ~self.initial  # initially debonded zones do not count as new damage
+        if np.isnan(self.first_damage) and np.any((d > 0) & fresh):
+            self.first_damage = np.array(lam, float)
+        if self.first_failure is None and np.any((d >= FULL_DAMAGE) & fresh):
+            self.first_failure = lam
+        # --- friction of the next step on the damaged share under compression: the thesis's
+        # slip-softening limit (4.76) without its adhesive part τ_Delam(0), which the cohesive law
+        # carries and softens: μ0 (τ_Delam(σ) - τ_Delam(0)) / (1 + (1/μ - 1)(g/g_T^μ)²), at least μ_C|σ|
+        dn = np.einsum("eqi,eqi->eq", delta, cb.A3)
+        sigma = blk.K * np.minimum(dn, 0.0)
+        gabs = np.linalg.norm(ds, axis=-1)
+        self.gmax = np.where(d > 0, np.maximum(self.gmax, gabs), self.gmax)
+        ratio = self.gmax / law.gT_mu if np.isfinite(law.gT_mu) else 0.0 * self.gmax
+        thesis_law = InterfaceLaw(law.sigma_max, law.tau_max, law.p)
+        cap = law.mu0 * (tau_delam(sigma, thesis_law) - law.tau_max) / (1.0 + (1.0 / law.mu - 1.0) * ratio**2)
+        cap = np.maximum(cap, law.mu_coulomb * np.abs(sigma))
+        newcap = np.where((d > 0) & (dn < 0), cap, 0.0)
+        # anchor: keep the committed friction traction continuous on the new limit
+        tconv = np.where(d[..., None] > 0, tf / np.where(d > 0, d, 1.0)[..., None], 0.0)
+        tn = np.linalg.norm(tconv, axis=-1)
+        x = np.clip(tn / np.where(newcap > 0, newcap, 1.0), 0.0, 0.999)
+        e = tconv / np.where(tn > 0, tn, 1.0)[..., None]
+        gTu = np.einsum("eqij,eqj->eqi", P, delta)
+        cb.g_p = np.where((newcap > 0)[..., None], gTu - (x * newcap)[..., None] * e / cb.alpha_T, gTu)
+        cb.cap = newcap
+        cb.t_n = tconv
 
 
 @dataclass
@@ -72,6 +145,10 @@ class InterfaceController:
     resolves: int = 0  # re-solutions in the current step
     lam: float = 0.0
     mesh_nodes: np.ndarray | None = None  # for plots
+    warnings: list = field(default_factory=list)  # set-up warnings (cohesive process zone)
+    energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
+    u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
+    f_last: np.ndarray | None = None  # [external force, layers' internal force] there
 
     # ------------------------------------------------------------------ set-up
     @classmethod
@@ -83,6 +160,9 @@ class InterfaceController:
             if itf.upper not in laws or itf.elements.size == 0:
                 continue
             law = laws[itf.upper]
+            if isinstance(law, CohesiveLaw):
+                runs.append(_cohesive_run(problem, itf, law, initial.get(itf.upper)))
+                continue
             alpha = law.alpha_N if law.alpha_N is not None else _default_penalty(model, itf)
             blk = ContactBlock.build(model, dm, itf, alpha)
             ne, nq = blk.w.shape
@@ -101,6 +181,7 @@ class InterfaceController:
                                      np.zeros((ne, nq, 3)), np.zeros((ne, nq), bool), np.full((ne, nq), np.nan),
                                      z.copy(), np.zeros((ne, nq, 3)), z.copy()))
         ctl = cls(runs, settings or DelaminationSettings(), mesh_nodes=model.mesh.nodes)
+        ctl.warnings = [w for r in runs if isinstance(r, CohesiveRun) for w in _process_zone_warning(model, r)]
         problem.extra_blocks = [r.block for r in runs]
         ctl.sync(problem)
         return ctl
@@ -108,9 +189,13 @@ class InterfaceController:
     def sync(self, problem) -> None:
         """Released flags of the contact points from the nodal bond state; friction load vector."""
         for r in self.runs:
+            if isinstance(r, CohesiveRun):
+                continue
             r.block.released = ~problem.bonded[r.block.itf.upper][r.block.conn[:, r.block.region]]
         F = np.zeros(problem.dm.n_full)
         for r in self.runs:
+            if isinstance(r, CohesiveRun):
+                continue
             if r.block.alpha_T is None:  # explicit friction: external loads
                 r.block.load_vector(r.tau * r.block.released[..., None], F)
         problem.F_friction = F
@@ -124,7 +209,12 @@ class InterfaceController:
         self.lam = lam
         model, dm = problem.model, problem.dm
         new_any = False
+        if any(isinstance(r, CohesiveRun) for r in self.runs):
+            self._path_energies(problem, u, lam)
         for r in self.runs:
+            if isinstance(r, CohesiveRun):
+                r.update(u, lam)
+                continue
             blk, itf = r.block, r.block.itf
             ne, nq = blk.w.shape
             ps = interface_state(model, dm, u, itf, "gauss", self.settings.stresses, lam)
@@ -239,9 +329,16 @@ class InterfaceController:
                 out[f"run{i}.{name}"] = np.array(getattr(r, name), copy=True)
             out[f"run{i}.first_failure"] = np.array(np.nan if r.first_failure is None else r.first_failure, float)
             for name in self.BLOCK_ARRAYS:
-                value = getattr(r.block, name)
+                value = getattr(_kin(r.block), name)
                 if value is not None:
                     out[f"run{i}.block.{name}"] = np.array(value, copy=True)
+            if isinstance(r, CohesiveRun):
+                out[f"run{i}.block.d_old"] = np.array(r.block.d_old, copy=True)
+                out[f"run{i}.block.dv_old"] = np.array(r.block.dv_old, copy=True)
+                out[f"run{i}.block.lam_old"] = np.array(r.block.lam_old, float)
+        out["energy"] = np.array(self.energy, copy=True)
+        if self.u_last is not None:
+            out["energy.u"], out["energy.f"] = self.u_last.copy(), self.f_last.copy()
         return out
 
     def restore(self, problem, state: dict[str, np.ndarray]) -> None:
@@ -273,9 +370,17 @@ class InterfaceController:
             ff = float(take(f"run{i}.first_failure", None))
             r.first_failure = None if np.isnan(ff) else ff
             for name in self.BLOCK_ARRAYS:
-                if getattr(r.block, name) is not None:
-                    setattr(r.block, name, take(f"run{i}.block.{name}", getattr(r.block, name)))
-            r.block.active = None
+                if getattr(_kin(r.block), name) is not None:
+                    setattr(_kin(r.block), name, take(f"run{i}.block.{name}", getattr(_kin(r.block), name)))
+            if isinstance(r, CohesiveRun):
+                r.block.d_old = take(f"run{i}.block.d_old", r.block.d_old)
+                r.block.dv_old = take(f"run{i}.block.dv_old", r.block.dv_old)
+                r.block.lam_old = float(take(f"run{i}.block.lam_old", None))
+            _kin(r.block).active = None
+        if "energy" in state:
+            self.energy = np.array(state["energy"], float)
+            self.u_last = np.array(state["energy.u"]) if "energy.u" in state else None
+            self.f_last = np.array(state["energy.f"]) if "energy.f" in state else None
         self.resolves = 0
         problem.rebuild_constraints()
         self.sync(problem)
@@ -291,20 +396,125 @@ class InterfaceController:
         areas = self.debonded_area()
         out = {}
         for r in self.runs:
-            P = r.block.X0[r.block.released]
+            P = _kin(r.block).X0[_released(r)]
             box = {f"{c}_{m}": (float(getattr(P[:, i], m)()) if P.size else None)
                    for i, c in enumerate("xy") for m in ("min", "max")}
-            out[r.block.itf.name] = {"area": areas[r.block.itf.name], **box}
+            out[_kin(r.block).itf.name] = {"area": areas[_kin(r.block).itf.name], **box}
         return out
 
     def debonded_fraction(self) -> float:
         """Released share of all interface area (for step cutting)."""
         a = sum(self.debonded_area().values())
-        A = sum(float(r.block.w0.sum()) for r in self.runs)
+        A = sum(float(_kin(r.block).w0.sum()) for r in self.runs)
         return a / A if A > 0 else 0.0
 
     def debonded_area(self) -> dict[str, float]:
-        return {r.block.itf.name: float((r.block.w0 * r.block.released).sum()) for r in self.runs}
+        return {_kin(r.block).itf.name: float((_kin(r.block).w0 * _released(r)).sum()) for r in self.runs}
+
+    # ------------------------------------------------------------------ cohesive results
+    def first_damage(self) -> float | None:
+        """Load factor of the first damage at a cohesive interface point (None: none yet)."""
+        vals = [float(r.first_damage) for r in self.runs if isinstance(r, CohesiveRun) and np.isfinite(r.first_damage)]
+        return min(vals) if vals else None
+
+    def _path_energies(self, problem, u: np.ndarray, lam: float) -> None:
+        """External work and the layers' strain energy as path integrals (trapezoid over the
+        converged states): W = Σ ½(F_k + F_k+1)·(u_k+1 - u_k), U = the same with the layers'
+        internal forces (the internal force less the interface blocks' forces)."""
+        F = problem.external(lam)
+        f, _ = problem.assembler.evaluate(u, tangent=False)
+        for b in problem.assembler.extra:
+            fe, _ = b.response(u, tangent=False)
+            f = f - np.bincount(b.dofs.ravel(), weights=fe.ravel(), minlength=f.size)
+        if self.u_last is None:
+            self.u_last, self.f_last = np.zeros_like(u), np.zeros((2, u.size))
+        du = u - self.u_last
+        self.energy = self.energy + 0.5 * np.array([(self.f_last[0] + F) @ du, (self.f_last[1] + f) @ du])
+        self.u_last, self.f_last = u.copy(), np.stack([F, f])
+
+    def energies(self, problem, u: np.ndarray) -> dict[str, float] | None:
+        """Energy ledger of a model with cohesive interfaces (None without): external work,
+        strain energy of the layers, elastic energy of the interfaces, dissipation by fracture,
+        friction and viscosity, and the balance error (external - stored - dissipated) relative
+        to the external work."""
+        coh = [r for r in self.runs if isinstance(r, CohesiveRun)]
+        if not coh:
+            return None
+        W, U = (float(v) for v in self.energy)
+        E_itf = sum(r.block.elastic_energy(u) for r in coh)
+        frac = sum(float(r.energy[0]) for r in coh)
+        fric = sum(float(r.energy[1]) for r in coh)
+        visc = sum(float(r.energy[2]) for r in coh)
+        err = W - U - E_itf - frac - fric - visc
+        return {"external_work": W, "strain_energy": U, "interface_elastic_energy": E_itf,
+                "dissipated_fracture": frac, "dissipated_friction": fric, "dissipated_viscous": visc,
+                "balance_error": err / W if W != 0 else 0.0}
+
+
+def _kin(block):
+    """The contact kinematics of a block (a cohesive block holds one)."""
+    return getattr(block, "contact", block)
+
+
+def _released(r) -> np.ndarray:
+    """Points that are released (thesis law) or fully damaged (cohesive law)."""
+    return r.block.d_old >= FULL_DAMAGE if isinstance(r, CohesiveRun) else r.block.released
+
+
+def default_cohesive_stiffness(model, itf: Interface, law: CohesiveLaw) -> float:
+    """K0 = α E3 / H (Turon, Dávila, Camanho & Costa 2007) with the larger E3/H of the two
+    adjacent layers (the thinner, stiffer one), α = ``law.alpha`` (50)."""
+    lo, up = model.layers[itf.lower], model.layers[itf.upper]
+    return law.alpha * max(lo.material.E3 / lo.thickness.min(), up.material.E3 / up.thickness.min())
+
+
+def cohesive_softening_estimate(model, itf: Interface, K: float) -> float:
+    """The compliance 1/K of the interface relative to the through-thickness compliance of the
+    two layers, Σ H/E3 (normal) - an upper estimate of how much the penalty softens the bonded
+    stack (the shear ratio, with G < E, is smaller)."""
+    lo, up = model.layers[itf.lower], model.layers[itf.upper]
+    return (1.0 / K) / (lo.thickness.min() / lo.material.E3 + up.thickness.min() / up.material.E3)
+
+
+def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> CohesiveRun:
+    """A cohesive interface: no bond constraint (both layers keep their DOFs everywhere), the
+    cohesive block on the chosen face rule; initially debonded zones start fully damaged."""
+    model, dm = problem.model, problem.dm
+    K = law.K0 if law.K0 is not None else default_cohesive_stiffness(model, itf, law)
+    cb = ContactBlock.build(model, dm, itf, K, rule=law.rule)
+    ne, nq = cb.w.shape
+    cb.released = np.ones((ne, nq), bool)
+    cb.alpha_T = law.alpha_T if law.alpha_T is not None else K
+    cb.cap, cb.t_n, cb.g_p = np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3))
+    problem.bonded[itf.upper] = np.zeros_like(problem.bonded[itf.upper])
+    d0 = np.zeros((ne, nq))
+    if initial_nodes is not None:
+        init = np.zeros(model.mesh.n_nodes, bool)
+        init[initial_nodes] = True
+        d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
+    blk = CohesiveBlock(cb, law, K, d0, dv_old=d0.copy())
+    return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
+                       np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
+
+
+def _process_zone_warning(model, r: CohesiveRun) -> list[str]:
+    """Turon et al. (2007): the cohesive zone l_cz ≈ E G_c / τ0² should span at least 3 node
+    spacings (about 3 elements are usually recommended; here the node spacing of the 9-node
+    elements, half an element)."""
+    cb = r.block.contact
+    lo, up = model.layers[cb.itf.lower], model.layers[cb.itf.upper]
+    E = min(lo.material.E3, up.material.E3)
+    lcz = r.law.process_zone_length(E)
+    X = model.mesh.nodes[cb.conn]  # (e, 9, 3)
+    # node spacing: half the shorter side of the largest elements (the front runs along one side)
+    h = 0.5 * min(float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).max()),
+                  float(np.linalg.norm(X[:, 3] - X[:, 0], axis=-1).max()))
+    if lcz >= 3.0 * h:
+        return []
+    return [f"interface '{cb.itf.name}': the cohesive process zone l_cz = E G_c / tau0^2 = {lcz:.4g} "
+            f"(E = {E:.4g}) spans {lcz / h:.2f} node spacings (h = {h:.4g}), fewer than 3: the peak load and the "
+            "debonding load are then mesh dependent (Turon et al. 2007); refine the mesh along the debonding "
+            "front, or check that G_Ic, G_IIc and the strengths are consistent"]
 
 
 def _default_stick(model, itf: Interface) -> float:

@@ -100,6 +100,9 @@ class Problem:
         return f - self.external(lam)
 
     def external(self, lam: float) -> np.ndarray:
+        for b in self.extra_blocks:  # rate-dependent blocks (viscous cohesive law) need λ
+            if hasattr(b, "set_load_factor"):
+                b.set_load_factor(lam)
         F = lam * self.F_scaled + self.F_const
         return F if self.F_friction is None else F + self.F_friction
 

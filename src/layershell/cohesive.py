@@ -1,0 +1,423 @@
+"""Cohesive (energy-based) interface law, issue 13: damage onset by a strength criterion,
+propagation by the fracture energies G_Ic, G_IIc with the Benzeggagh–Kenane mixed-mode law.
+
+Material point (pure functions over arrays of points). Separation δ = Δu (upper layer's bottom
+face relative to the lower layer's top face, :mod:`layershell.contact`), split along the
+undeformed normal A3 into δ_n = δ·A3 and the tangential vector δ_s = (I - A3⊗A3) δ. One initial
+(penalty) stiffness K per area in both directions (Turon, Dávila, Camanho & Costa 2007:
+K = α E3 / t, α ≈ 50). With the damage d ∈ [0, 1] (Camanho & Dávila 2002; Turon et al. 2006):
+
+    t = K δ - d K (<δ_n> A3 + δ_s)                 (compression δ_n < 0 never damages)
+    λ = sqrt(<δ_n>² + |δ_s|²)                       equivalent separation
+    B = |δ_s|² / λ²                                 mode ratio G_shear / G_T (equal stiffness)
+    G_c(B) = G_Ic + (G_IIc - G_Ic) B^η              Benzeggagh & Kenane 1996
+    λ0(B): onset, where the undamaged traction K λ meets the strength criterion
+      * "thesis":    |τ| = τ_max (1 - σ/σ_max)^(1/p)  (thesis (4.15), (4.21)), σ = K <δ_n>, |τ| = K |δ_s|
+      * "quadratic": (<σ>/σ_max)² + (|τ|/τ_max)² = 1
+    λf(B) = 2 G_c(B) / (K λ0(B))                    bilinear: the area under t(λ) is G_c(B)
+    d_trial = λf (λ - λ0) / (λ (λf - λ0)) clipped to [0, 1]    (bilinear)
+    d_trial = 1 - (λ0/λ) exp(-(λ - λ0)/λc), λc = (G_c - K λ0²/2) / (K λ0)    (exponential)
+    d = max(d_old, d_trial)                         irreversible, d_old the last converged value
+
+With d itself as the history variable the damage never decreases when the mode ratio changes
+(the concern of Turon et al. 2010), and a proportional path dissipates exactly G_c(B). The
+consistent tangent includes ∂d/∂λ and ∂d/∂B (through λ0(B), λf(B)) where the damage grows.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: damage counted as "fully debonded" (first_delamination_load_factor, debonded area)
+FULL_DAMAGE = 1.0 - 1e-9
+
+
+@dataclass(frozen=True)
+class CohesiveLaw:
+    """Parameters of a cohesive interface (issue 13).
+
+    G_Ic, G_IIc: fracture energies (energy per area); eta: Benzeggagh–Kenane exponent;
+    sigma_max, tau_max, p: strengths and exponent of the onset criterion; onset: "thesis" (4.15)
+    or "quadratic"; softening: "bilinear" or "exponential"; K0: penalty stiffness per area
+    (None: alpha E3/t of the adjacent layers); alpha: the factor of that default (Turon 2007);
+    viscosity: Gao & Bower (2004) regularisation time in load-factor units (0: off);
+    mu0, mu, gT_mu, mu_coulomb: the thesis's adhesive slip-softening friction (4.70)-(4.84),
+    which acts on the damaged share of a point under compression; alpha_T: its stick penalty
+    (None: K0); rule: "lobatto" (nodal, default) or "gauss" integration of the interface.
+    """
+
+    G_Ic: float
+    G_IIc: float
+    sigma_max: float
+    tau_max: float
+    eta: float = 2.0
+    p: float = 2.0
+    onset: str = "thesis"
+    softening: str = "bilinear"
+    K0: float | None = None
+    alpha: float = 50.0
+    viscosity: float = 0.0
+    mu0: float = 0.95
+    mu: float = 0.2
+    gT_mu: float = float("inf")
+    mu_coulomb: float = 0.0
+    alpha_T: float | None = None
+    rule: str = "lobatto"
+
+    def check(self, name: str = "interface") -> None:
+        """Raise ValueError with one message naming every bad field and its fix."""
+        bad = []
+        for key in ("G_Ic", "G_IIc"):
+            v = getattr(self, key)
+            if v is None or not v > 0:
+                bad.append(f"'{name}.{key}' = {v}: the fracture energy must be a positive energy per area "
+                           f"(e.g. N/mm = kN/m for a bond); take it from a fracture test or the literature")
+        for key in ("sigma_max", "tau_max"):
+            v = getattr(self, key)
+            if v is None or not v > 0:
+                bad.append(f"'{name}.{key}' = {v}: the strength of the onset criterion must be positive")
+        if not self.eta > 0:
+            bad.append(f"'{name}.eta' = {self.eta}: the Benzeggagh–Kenane exponent must be positive (1-3 typical)")
+        if not self.p >= 1:
+            bad.append(f"'{name}.p' = {self.p}: must be >= 1 (4.19)")
+        if self.onset not in ("thesis", "quadratic"):
+            bad.append(f"'{name}.onset' = {self.onset!r}: use \"thesis\" or \"quadratic\"")
+        if self.softening not in ("bilinear", "exponential"):
+            bad.append(f"'{name}.softening' = {self.softening!r}: use \"bilinear\" or \"exponential\"")
+        if self.K0 is not None and not self.K0 > 0:
+            bad.append(f"'{name}.K0' = {self.K0}: the penalty stiffness must be positive (or left out)")
+        if not self.alpha > 0:
+            bad.append(f"'{name}.alpha' = {self.alpha}: must be positive (about 50, Turon et al. 2007)")
+        if not self.viscosity >= 0:
+            bad.append(f"'{name}.viscosity' = {self.viscosity}: must not be negative (0 switches it off)")
+        if self.rule not in ("lobatto", "gauss"):
+            bad.append(f"'{name}.rule' = {self.rule!r}: use \"lobatto\" (nodal) or \"gauss\"")
+        if bad:
+            raise ValueError("; ".join(bad))
+
+    def G_c(self, B):
+        """Benzeggagh–Kenane mixed-mode fracture energy G_c(B) (BK 1996)."""
+        return self.G_Ic + (self.G_IIc - self.G_Ic) * np.asarray(B, float) ** self.eta
+
+    def process_zone_length(self, E: float) -> float:
+        """l_cz = E G_c / τ0² with the smaller of the two modes' ratios (Turon et al. 2007, M = 1)."""
+        return E * min(self.G_Ic / self.sigma_max**2, self.G_IIc / self.tau_max**2)
+
+
+# ---------------------------------------------------------------------- onset
+def onset(B: np.ndarray, K: float, law: CohesiveLaw) -> tuple[np.ndarray, np.ndarray]:
+    """λ0(B) and dλ0/dB: the equivalent separation at which the undamaged traction K λ (normal
+    share sqrt(1-B), shear share sqrt(B)) meets the onset criterion."""
+    B = np.clip(np.asarray(B, float), 0.0, 1.0)
+    cn, cs = np.sqrt(1.0 - B), np.sqrt(B)
+    N, S = law.sigma_max, law.tau_max
+    if law.onset == "quadratic":
+        q = (1.0 - B) / N**2 + B / S**2
+        lam0 = 1.0 / (K * np.sqrt(q))
+        dq = -1.0 / N**2 + 1.0 / S**2
+        return lam0, -0.5 * lam0 * dq / q
+    # thesis (4.15): g(λ, B) = K λ cs - S (1 - K λ cn / N)^(1/p) = 0, increasing in λ; root in
+    # [0, N/(K cn)] (the tensile cut-off (4.20)) - Newton from the bracket's side, safeguarded
+    p = law.p
+    hi = np.where(cn > 0, N / (K * np.maximum(cn, 1e-300)), S / K * 1.0)
+    hi = np.where(cs > 0, np.minimum(hi, S / (K * np.maximum(cs, 1e-300))), hi)  # g(S/(K cs)) >= 0
+    lo = np.zeros_like(B)
+    lam = 0.5 * (lo + hi)
+    with np.errstate(all="ignore"):
+        return _onset_thesis(B, K, law, cn, cs, lo, hi, lam)
+
+
+def _onset_thesis(B, K, law, cn, cs, lo, hi, lam):
+    """Safeguarded Newton for the thesis's onset (see :func:`onset`)."""
+    N, S, p = law.sigma_max, law.tau_max, law.p
+    for _ in range(60):
+        base = np.clip(1.0 - K * lam * cn / N, 0.0, None)
+        g = K * lam * cs - S * base ** (1.0 / p)
+        gl = K * cs + S / p * base ** (1.0 / p - 1.0) * K * cn / N if p != 1 else K * cs + S * K * cn / N
+        lo = np.where(g < 0, lam, lo)
+        hi = np.where(g >= 0, lam, hi)
+        with np.errstate(all="ignore"):
+            nxt = lam - g / gl
+        ok = np.isfinite(nxt) & (nxt > lo) & (nxt < hi)
+        new = np.where(ok, nxt, 0.5 * (lo + hi))
+        if np.all(np.abs(new - lam) <= 1e-15 * np.maximum(hi, 1e-300)):
+            lam = new
+            break
+        lam = new
+    base = np.clip(1.0 - K * lam * cn / N, 0.0, None)
+    # implicit derivative dλ/dB = -g_B / g_λ, with dcn/dB = -1/(2 cn), dcs/dB = 1/(2 cs)
+    with np.errstate(all="ignore"):
+        dpow = S / p * base ** (1.0 / p - 1.0) * K / N
+        g_l = K * cs + dpow * cn
+        g_B = K * lam * 0.5 / np.where(cs > 0, cs, np.inf) + dpow * lam * (-0.5 / np.where(cn > 0, cn, np.inf))
+        dlam = -g_B / g_l
+    # at the ends (pure modes) the one-sided derivative is unbounded or undefined: the tangent
+    # uses 0 there (B is stationary in the pure modes anyway: ∂B/∂δ = 0 at B = 0 and B = 1)
+    dlam = np.where(np.isfinite(dlam) & (B > 0) & (B < 1), dlam, 0.0)
+    return lam, dlam
+
+
+# ---------------------------------------------------------------------- damage
+def damage_trial(lam: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw):
+    """d_trial(λ, B) and its partial derivatives ∂d/∂λ, ∂d/∂B (softening law of ``law``)."""
+    lam = np.asarray(lam, float)
+    l0, dl0 = onset(B, K, law)
+    Gc = law.G_c(B)
+    dGc = (law.G_IIc - law.G_Ic) * law.eta * np.clip(B, 1e-300, 1.0) ** (law.eta - 1.0)
+    dGc = np.where(B > 0, dGc, 0.0) if law.eta < 1 else dGc
+    lsafe = np.maximum(lam, 1e-12 * l0)  # d = 0 below λ0 anyway
+    if law.softening == "bilinear":
+        lf = 2.0 * Gc / (K * l0)
+        dlf = 2.0 * dGc / (K * l0) - lf / l0 * dl0
+        lf = np.maximum(lf, l0 * (1.0 + 1e-9))  # brittle: immediate loss (guarded in build)
+        span = lf - l0
+        d = lf * (lam - l0) / (lsafe * span)
+        soft = (lam > l0) & (lam < lf)
+        dd_l = lf * l0 / (lsafe**2 * span)
+        # ∂d/∂l0 = lf (lam - lf) / (lam span²), ∂d/∂lf = -l0 (lam - l0)/(lam span²)
+        dd_l0 = lf * (lam - lf) / (lsafe * span**2)
+        dd_lf = -l0 * (lam - l0) / (lsafe * span**2)
+        dd_B = dd_l0 * dl0 + dd_lf * dlf
+    else:
+        lc = (Gc - 0.5 * K * l0**2) / (K * l0)
+        dlc = dGc / (K * l0) - Gc / (K * l0**2) * dl0 - 0.5 * dl0
+        lc = np.maximum(lc, 1e-12 * l0)
+        ex = np.exp(-np.clip(lam - l0, 0.0, None) / lc)
+        d = 1.0 - l0 / lsafe * ex
+        soft = lam > l0
+        # d = 1 - (l0/λ) e, e = exp(-(λ-l0)/lc)
+        dd_l = l0 / lsafe * ex * (1.0 / lsafe + 1.0 / lc)
+        dd_l0 = -ex / lsafe - l0 / lsafe * ex / lc
+        dd_lc = -l0 / lsafe * ex * (lam - l0) / lc**2
+        dd_B = dd_l0 * dl0 + dd_lc * dlc
+    d = np.where(lam >= l0, np.clip(d, 0.0, 1.0), 0.0)
+    return d, np.where(soft, dd_l, 0.0), np.where(soft, dd_B, 0.0)
+
+
+def separation_measures(delta: np.ndarray, n: np.ndarray):
+    """δ_n, δ_s (vector), λ, B and their derivatives ∂λ/∂δ, ∂B/∂δ (..., 3) for separations
+    ``delta (..., 3)`` with unit normals ``n (..., 3)``."""
+    dn = np.einsum("...i,...i->...", delta, n)
+    ds = delta - dn[..., None] * n
+    dnp = np.maximum(dn, 0.0)
+    s2 = np.einsum("...i,...i->...", ds, ds)
+    lam2 = dnp**2 + s2
+    lam = np.sqrt(lam2)
+    pos = lam > 0
+    ls = np.where(pos, lam, 1.0)
+    B = np.where(pos, s2 / np.where(pos, lam2, 1.0), 0.0)
+    g = dnp[..., None] * n + ds  # ∂(λ²/2)/∂δ
+    dlam = g / ls[..., None] * pos[..., None]
+    dB = (2.0 * ds - 2.0 * B[..., None] * g) / np.where(pos, lam2, 1.0)[..., None] * pos[..., None]
+    return dn, ds, lam, B, dlam, dB
+
+
+def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float, law: CohesiveLaw,
+                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None):
+    """Traction t (..., 3), damage d (...) and the consistent tangent dt/dδ (..., 3, 3) of the
+    cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``.
+    ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow). ``frozen``:
+    (tension, loading) masks that replace δ_n > 0 and d_trial > d_old (an active-set iteration:
+    the response is then smooth; the caller checks the sets after convergence)."""
+    dn, ds, lam, B, dlam, dB = separation_measures(delta, n)
+    if frozen is not None:  # λ, B and their derivatives with the frozen tension state
+        tension, loading_f = frozen
+        dnp = np.where(tension, dn, 0.0)
+        lam2 = dnp**2 + np.einsum("...i,...i->...", ds, ds)
+        lam = np.sqrt(lam2)
+        pos = lam > 0
+        ls = np.where(pos, lam, 1.0)
+        B = np.where(pos, (lam2 - dnp**2) / np.where(pos, lam2, 1.0), 0.0)
+        gv = dnp[..., None] * n + ds
+        dlam = gv / ls[..., None] * pos[..., None]
+        dB = (2.0 * ds - 2.0 * B[..., None] * gv) / np.where(pos, lam2, 1.0)[..., None] * pos[..., None]
+    dt, dd_l, dd_B = damage_trial(lam, B, K, law)
+    loading = dt > d_old if frozen is None or loading_f is None else loading_f
+    d = np.where(loading, dt, d_old)
+    # δ_n = 0 counts as tension (the same traction; the tangent of an opening point - a damaged
+    # point that starts at δ_n = 0, e.g. an initial crack at u = 0, then opens in one iteration)
+    tens = dn >= 0 if frozen is None else tension
+    g = np.where(tens, dn, 0.0)[..., None] * n + ds  # the damageable part of δ
+    t = K * delta - (K * d)[..., None] * g
+    if not tangent:
+        return t, d, None
+    eye = np.eye(3)
+    nn = n[..., :, None] * n[..., None, :]
+    dg = np.where(tens[..., None, None], eye, eye - nn)  # ∂g/∂δ
+    D = K * eye - (K * d)[..., None, None] * dg
+    dd = (dd_l[..., None] * dlam + dd_B[..., None] * dB) * loading[..., None]
+    D = D - K * g[..., :, None] * dd[..., None, :]
+    return (t, d, D, dd) if with_dd else (t, d, D)
+
+
+def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.ndarray:
+    """Energy per area dissipated by monotonic damage growth from 0 to ``d`` at the mode ratio B
+    (bilinear law, closed form ∫ ½Kλ² dd = ½ K λ0² λf d / (λf - d (λf - λ0)); it reaches G_c(B)
+    at d = 1). For the exponential law the same integral is evaluated numerically."""
+    l0, _ = onset(B, K, law)
+    d = np.clip(np.asarray(d, float), 0.0, 1.0)
+    if law.softening == "bilinear":
+        lf = np.maximum(2.0 * law.G_c(B) / (K * l0), l0 * (1 + 1e-9))
+        return 0.5 * K * l0**2 * lf * d / (lf - d * (lf - l0))
+    # exponential: the work up to λ(d) minus the stored energy, W(λ) = ½Kλ0² + Kλ0λc(1 - e^(-(λ-λ0)/λc)),
+    # with λ(d) by bisection on [λ0, λ0 + 60 λc]
+    Gc = law.G_c(B)
+    lc = np.maximum((Gc - 0.5 * K * l0**2) / (K * l0), 1e-12 * l0)
+    lo, hi = l0 * np.ones_like(d), l0 + 60.0 * lc
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        dm = 1.0 - l0 / mid * np.exp(-(mid - l0) / lc)
+        lo, hi = np.where(dm < d, mid, lo), np.where(dm < d, hi, mid)
+    lam = 0.5 * (lo + hi)
+    W = 0.5 * K * l0**2 + K * l0 * lc * (1.0 - np.exp(-(lam - l0) / lc))
+    return np.where(d > 0, W - 0.5 * (1.0 - d) * K * lam**2, 0.0)
+
+
+# ---------------------------------------------------------------------- interface block
+@dataclass
+class CohesiveBlock:
+    """Element-like block of one cohesive interface: the layers on both sides keep their own
+    DOFs (no bond constraint) and are coupled by the cohesive tractions at the face points.
+
+    Kinematics, DOFs and weights are those of :class:`~layershell.contact.ContactBlock` (its
+    relative displacement Δu = C U (4.43)-(4.44), its normal A3 and its friction return
+    mapping), built on the chosen face rule. The sparsity pattern is fixed (every element's
+    full matrix), so the block is element-like. The tangent is not symmetric where the damage
+    grows (K g ⊗ ∂d/∂δ)."""
+
+    contact: object  # ContactBlock (kinematics, friction state: cap, g_p, alpha_T)
+    law: CohesiveLaw
+    K: float
+    d_old: np.ndarray  # (e, q) converged damage (history variable)
+    frozen: tuple | None = None  # (tension, loading) during an active-set solve
+    # viscous regularisation (Gao & Bower 2004), law.viscosity = η > 0: the acting damage d_v
+    # follows the rate-independent d with ḋ_v = (d - d_v)/η in load-factor time, backward Euler
+    # d_v = (d_v,old + r d)/(1 + r), r = Δλ/η (never decreasing)
+    dv_old: np.ndarray | None = None  # (e, q) converged acting damage (= d_old without viscosity)
+    lam_old: float = 0.0  # load factor of the last commit
+    lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
+    last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
+    symmetric = False
+    compact_tangent = False
+
+    # ------------------------------------------------------------------ active set (solver/newton.py)
+    def gap(self, u_full: np.ndarray) -> np.ndarray:
+        """Normal separation δ_n (e, q)."""
+        return np.einsum("eqi,eqi->eq", self.separation(u_full), self.contact.A3)
+
+    def freeze(self, u_full: np.ndarray) -> None:
+        """Fix the tension/compression state of every point for the next Newton iterations
+        (the jump of the normal stiffness of a damaged point at δ_n = 0 is the contact-like
+        non-smoothness; the damage growth d = max(d_old, d_trial) stays semi-smooth)."""
+        self.frozen = None
+        self.frozen = (self.gap(u_full) >= 0, None)
+
+    def set_changed(self, u_full: np.ndarray) -> bool:
+        """Does the frozen tension state still hold at the converged ``u_full`` (where it
+        matters: at damaged points, judged without the frozen state)?"""
+        if self.frozen is None:
+            return False
+        frozen, self.frozen = self.frozen, None
+        _, _, d, _ = self.point_state(u_full)
+        self.frozen = frozen
+        return bool(np.any(((self.gap(u_full) >= 0) != frozen[0]) & (d > 0)))
+
+    def unfreeze(self) -> None:
+        self.frozen = None
+
+    # the attributes that assembly / results read from a block
+    @property
+    def dofs(self) -> np.ndarray:
+        return self.contact.dofs
+
+    @property
+    def w(self) -> np.ndarray:
+        return self.contact.w
+
+    # read by results, probes, plots (as from a ContactBlock)
+    itf = property(lambda self: self.contact.itf)
+    conn = property(lambda self: self.contact.conn)
+    region = property(lambda self: self.contact.region)
+    w0 = property(lambda self: self.contact.w0)
+    X0 = property(lambda self: self.contact.X0)
+
+    @property
+    def released(self) -> np.ndarray:
+        """Fully damaged points (e, q)."""
+        return self.d_old >= FULL_DAMAGE
+
+    def separation(self, u_full: np.ndarray) -> np.ndarray:
+        """Δu (e, q, 3) at the face points."""
+        ne, nq, nk = self.contact.c.shape
+        return np.matmul(self.contact.c, u_full[self.dofs].reshape(ne, nk, 3))
+
+    def set_load_factor(self, lam: float) -> None:
+        """The load factor of the coming solve (pseudo-time of the viscous regularisation)."""
+        self.lam_trial = float(lam)
+
+    def point_state(self, u_full: np.ndarray, with_dd: bool = False):
+        """(δ, t, d, D[, ∂d/∂δ]) of the cohesive law at every face point; d is the acting damage
+        (the viscous one where ``law.viscosity`` > 0; the rate-independent one is kept in
+        ``last_inviscid``)."""
+        delta = self.separation(u_full)
+        n = self.contact.A3
+        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen)
+        self.last_inviscid = d
+        if self.law.viscosity > 0:
+            r = max(self.lam_trial - self.lam_old, 0.0) / self.law.viscosity
+            dv_old = self.d_old if self.dv_old is None else self.dv_old
+            dv = (dv_old + r * d) / (1.0 + r)
+            grow = dv > dv_old
+            dv = np.where(grow, dv, dv_old)
+            ddv = np.where(grow[..., None], r / (1.0 + r) * dd, 0.0)
+            # t = Kδ - K d g, D = K I - K d ∂g/∂δ - K g ⊗ ∂d/∂δ: swap d for d_v
+            dn = np.einsum("eqi,eqi->eq", delta, n)
+            tens = dn >= 0 if self.frozen is None else self.frozen[0]
+            g = np.where(tens, dn, 0.0)[..., None] * n + (delta - dn[..., None] * n)
+            nn = n[..., :, None] * n[..., None, :]
+            dg = np.where(tens[..., None, None], np.eye(3), np.eye(3) - nn)
+            t = t + (self.K * (d - dv))[..., None] * g
+            D = (D + (self.K * (d - dv))[..., None, None] * dg
+                 + self.K * g[..., :, None] * (dd - ddv)[..., None, :])
+            d, dd = dv, ddv
+        return (delta, t, d, D, dd) if with_dd else (delta, t, d, D)
+
+    def tractions(self, u_full: np.ndarray):
+        """Total traction (cohesive + friction on the damaged share) t (e, q, 3), the cohesive
+        part, the friction part and the damage d (e, q)."""
+        delta, t, d, _ = self.point_state(u_full)
+        tf = np.zeros_like(t)
+        if self.contact.cap is not None and np.any(self.contact.cap > 0):
+            tf, _ = self.contact.friction_traction(u_full, delta)
+        return t + d[..., None] * tf, t, tf, d
+
+    def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False):
+        """Internal force (e, m) and tangent (e, m, m): f_(k,i) = Σ_q c_qk w_q T_qi and
+        K_(k,i)(l,j) = Σ_q c_qk c_ql w_q D_qij (C = c ⊗ I₃, as in ContactBlock.response)."""
+        cb = self.contact
+        ne, nq, nk = cb.c.shape
+        delta, t, d, D, dd = self.point_state(u_full, with_dd=True)
+        T = t
+        friction = cb.cap is not None and np.any(cb.cap > 0)
+        if friction:
+            tf, Df = cb.friction_traction(u_full, delta)
+            T = t + d[..., None] * tf
+        f = np.matmul(cb.c.transpose(0, 2, 1), cb.w[..., None] * T).reshape(ne, 3 * nk)
+        if not tangent:
+            return f, None
+        M = D
+        if friction:
+            M = M + d[..., None, None] * Df + tf[..., :, None] * dd[..., None, :]
+        M = cb.w[..., None, None] * M
+        c = cb.c
+        cM = (c[:, :, None, :, None] * M[:, :, :, None, :]).reshape(ne, nq, 9 * nk)
+        K = np.matmul(c.transpose(0, 2, 1), cM).reshape(ne, 3 * nk, 3 * nk)
+        return f, K
+
+    def elastic_energy(self, u_full: np.ndarray) -> float:
+        """Stored energy of the cohesive springs ½K|δ|² - ½dK|<δ_n>n + δ_s|² integrated."""
+        delta, _, d, _ = self.point_state(u_full)
+        dn, ds, lam, _, _, _ = separation_measures(delta, self.contact.A3)
+        psi = 0.5 * self.K * np.einsum("eqi,eqi->eq", delta, delta) - 0.5 * d * self.K * lam**2
+        return float((self.contact.w * psi).sum())

@@ -1,0 +1,138 @@
+"""Double cantilever beam (mode I) with a cohesive interface against corrected beam theory
+(Williams 1989), examples/dcb_cohesive.toml."""
+import numpy as np
+import pytest
+
+from helpers import run_example
+
+# inputs of examples/dcb_cohesive.toml
+E11, E22, G13 = 150000.0, 11000.0, 6000.0
+B, H, A0, GIC = 20.0, 1.98, 55.0, 0.352
+
+
+def chi() -> float:
+    """Crack-length correction of corrected beam theory, Williams (1989)."""
+    gamma = 1.18 * np.sqrt(E11 * E22) / G13
+    return float(np.sqrt(E11 / (11 * G13) * (3 - 2 * (gamma / (1 + gamma)) ** 2)))
+
+
+def cbt_compliance(a: float) -> float:
+    """Opening / load of both arms, C = 8 (a + χh)³ / (E11 b h³)."""
+    return 8 * (a + chi() * H) ** 3 / (E11 * B * H**3)
+
+
+def cbt_load(a: float) -> float:
+    """Load at G = G_Ic: P = b / (a + χh) sqrt(G_Ic E11 h³ / 12)."""
+    return B / (a + chi() * H) * np.sqrt(GIC * E11 * H**3 / 12)
+
+
+def opening(step) -> float:
+    p = step["probes"]
+    return p["w_upper"] - p["w_lower"]
+
+
+def test_dcb_initial_compliance_against_corrected_beam_theory():
+    """Below the onset of damage the opening/load ratio of the DCB (55 mm initial crack) is
+    within 3 % of corrected beam theory."""
+    r = run_example("dcb_cohesive", {"nx = 150": "nx = 75", "factors = [0.01, 0.02, 0.05,": "factors = [0.05] #"})
+    st = r.summary["steps"][0]
+    C = opening(st) / st["probes"]["P"]
+    assert C == pytest.approx(cbt_compliance(A0), rel=0.03)
+    assert r.summary["first_damage_load_factor"] is None  # nothing damaged yet at 5 N
+
+
+def check_peak(steps) -> dict:
+    """The last converged state under force control (the peak): its load P, the crack length that
+    corrected beam theory infers from its secant compliance, and the beam-theory load there."""
+    last = steps[-1]
+    P, d = last["probes"]["P"], opening(last)
+    a_plus = (d / P * E11 * B * H**3 / 8) ** (1 / 3)  # a + χh from C = 8 (a + χh)³ / (E b h³)
+    return {"P": P, "a": a_plus - chi() * H, "P_cbt": B / a_plus * np.sqrt(GIC * E11 * H**3 / 12)}
+
+
+@pytest.mark.slow
+def test_dcb_peak_under_force_control_against_corrected_beam_theory():
+    """Under force control the DCB (150 elements, 9 node spacings in the process zone) runs to
+    its peak and stops there. The peak state lies on the corrected-beam-theory propagation curve:
+    the load is within 3 % of P_CBT at the crack length inferred from the state's compliance
+    (measured: 60.0 N at the last completed step against 61.4 N, -2.2 %), and the crack has
+    started to grow (a = 56.7 mm). (The beam-theory load at the initial crack, 63.1 N, is 4.9 %
+    higher: the process zone has already moved the effective crack tip.)"""
+    r = run_example("dcb_cohesive")
+    assert not r.summary["converged"]  # force control cannot pass the peak
+    pk = check_peak(r.summary["steps"])
+    assert pk["a"] > A0
+    assert pk["P"] == pytest.approx(pk["P_cbt"], rel=0.03)
+    assert r.summary["first_delamination_load_factor"] is not None
+    e = r.summary["energy"]
+    assert abs(e["balance_error"]) < 0.01
+
+
+@pytest.mark.skip(reason="waits for displacement control (issue 13 item 2, helper 'path'): the propagation "
+                         "branch P(δ) of the DCB falls; under force control the run stops at the peak")
+def test_dcb_propagation_branch_against_corrected_beam_theory():
+    """Propagation branch under displacement control: at every point past the peak, the load
+    is within 3 % of the beam-theory load P(a) at the crack length a that corrected beam theory
+    infers from the secant compliance C = δ/P (Williams 1989).
+
+    To switch on: give examples/dcb_cohesive.toml a prescribed opening at x = 0 (upper arm +z,
+    lower arm -z, scaled by λ, e.g. δ = λ × 10 mm) instead of the two edge loads, a reaction
+    probe P over the loaded edge, and steps to about δ = 10 mm; then remove the skip."""
+    r = run_example("dcb_cohesive")
+    steps = r.summary["steps"]
+    P = np.array([s["probes"]["P"] for s in steps])
+    d = np.array([opening(s) for s in steps])
+    peak = int(np.argmax(P))
+    assert peak < len(P) - 3, "no propagation branch traced"
+    for Pi, di in zip(P[peak + 1:], d[peak + 1:]):
+        a_plus = (di / Pi * E11 * B * H**3 / 8) ** (1 / 3)  # a + χh from the compliance
+        assert Pi == pytest.approx(B / a_plus * np.sqrt(GIC * E11 * H**3 / 12), rel=0.03)
+
+
+def _tractions_ahead_of_tip(rule: str):
+    from pathlib import Path
+
+    from helpers import EXAMPLES
+    from layershell.io.build import build, parse
+    from layershell.solver.newton import newton
+    from layershell.solver.problem import Problem
+
+    text = (Path(EXAMPLES) / "dcb_cohesive.toml").read_text().replace("nx = 150", "nx = 75")
+    spec = build(parse(text.replace("eta = 2.284", f'eta = 2.284\nrule = "{rule}"'), "dcb"))
+    pb = Problem.build(spec.model)
+    u, res = newton(pb, np.zeros(pb.dm.n_full), 0.05, spec.newton)
+    assert res.converged
+    blk = pb.extra_blocks[0]
+    T, *_ = blk.tractions(u)
+    X, Y = blk.X0[..., 0], blk.X0[..., 1]
+    m = (np.abs(Y - 10) < 1.0) & (X > 54.9) & (X < 66)
+    o = np.argsort(X[m])
+    return X[m][o], T[..., 2][m][o]
+
+
+def test_nodal_integration_avoids_traction_oscillations():
+    """Peel stresses ahead of the DCB crack tip with the stiff default penalty: the beam on an
+    elastic foundation gives a smooth field - tension at the tip, then one change to a decaying
+    compression. Nodal (Lobatto) integration reproduces that; 3×3 Gauss integration makes the
+    tractions oscillate from point to point with several times the amplitude (Schellekens &
+    de Borst 1993)."""
+    x, t_lob = _tractions_ahead_of_tip("lobatto")
+    _, t_gauss = _tractions_ahead_of_tip("gauss")
+    sign_changes = lambda t: int(np.sum(np.diff(np.sign(t[np.abs(t) > 1e-9])) != 0))  # noqa: E731
+    assert t_lob[0] > 0 and sign_changes(t_lob) == 1
+    assert sign_changes(t_gauss) >= 4
+    assert np.abs(t_gauss).max() > 3 * np.abs(t_lob).max()
+
+
+def test_enf_initial_compliance_against_beam_theory():
+    """ENF (examples/enf_cohesive.toml) before damage: deflection under the load / load within
+    5 % of beam theory with the Wang & Williams (1992) crack-length correction,
+    C = (3 (a + 0.42 χh)³ + 2 L³) / (8 E11 b h³) (measured +3.4 %: the arms' transverse shear,
+    which beam theory leaves out, makes the shell model softer)."""
+    r = run_example("enf_cohesive", {"factors = [0.1, 0.2,": "factors = [0.05] #"})
+    st = r.summary["steps"][0]
+    assert r.summary["first_damage_load_factor"] is None
+    a, L = 25.0 + 0.42 * chi() * H, 50.0
+    C_beam = (3 * a**3 + 2 * L**3) / (8 * E11 * B * H**3)
+    C = st["probes"]["w_load"] / st["probes"]["P"]
+    assert C > C_beam and C == pytest.approx(C_beam, rel=0.05)
