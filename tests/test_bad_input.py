@@ -109,6 +109,12 @@ def test_no_loads_run_warns_and_runs(tmp_path):
     assert "warning:" in o.stderr and "no [[loads]]" in o.stderr, _describe(o)
 
 
+def test_displacement_control_without_loads_is_not_warned(tmp_path):
+    """A model loaded only by prescribed displacements (a fix with a 'value') is not 'unloaded'."""
+    o = _outcome(tmp_path, "dcb", Case("dcb_cohesive.toml", lambda d: d))
+    assert o.returncode == 0 and "OK" in o.stdout and "warning" not in o.stderr, _describe(o)
+
+
 def test_zero_loads_are_warned(tmp_path):
     o = _outcome(tmp_path, "zeroload", Case("cantilever_thick.toml", _set("loads.0.distribution", 0.0)))
     assert o.returncode == 0 and "OK" in o.stdout, _describe(o)

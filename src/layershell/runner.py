@@ -157,7 +157,7 @@ def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck,
     state = PathState.from_arrays(ck.extra) if ck is not None else None
 
     def watch(uu, lam):
-        return {p.name: p.value(spec.model, problem.dm, uu, lam, ctl) for p in spec.probes}
+        return {p.name: p.value(spec.model, problem.dm, uu, lam, ctl, problem=problem) for p in spec.probes}
 
     return path_steps(problem, spec.newton, spec.path_following, u0=u, lam0=lam0, step0=step0, state=state,
                       on_step_end=on_step_end, measure=(lambda pb: pb.interfaces.debonded_fraction())
@@ -443,7 +443,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u
-                vals = {p.name: p.value(model, problem.dm, u, st.load_factor, problem.interfaces)
+                vals = {p.name: p.value(model, problem.dm, u, st.load_factor, problem.interfaces, problem=problem)
                         for p in spec.probes}
                 rec = {"step": st.step, "load_factor": st.load_factor, "iterations": st.iterations,
                        "bisections": st.bisections, "wall_seconds": round(st.wall_seconds, 4), "probes": vals}

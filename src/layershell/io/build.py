@@ -961,7 +961,11 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
             model.nodal_loads.append(NodalLoad(nodes, k, ld.director, np.asarray(ld.value, float), ld.scaled))
 
     notes = []
-    if not mf.loads:
+    # prescribed displacements (a fix with a non-zero 'value') load the model as well
+    moved = any(getattr(sd, "value", None) and any(v != 0 for v in sd.value) for sd in mf.supports)
+    if moved:
+        pass
+    elif not mf.loads:
         notes.append("the model has no [[loads]], so every displacement, stress and probe value is zero; add a "
                      "[[loads]] table (type = 'surface', 'edge', 'volume', 'gravity' or 'nodal'), see examples/")
     elif all(_zero_load(ld) for ld in mf.loads):

@@ -95,7 +95,10 @@ class Probe:
         every layer at those nodes: u_0L = e (× X_L), u_1L = e × A3 (rotation), higher
         directors 0 (MODEL.md (3.40)). Zero at all other nodes, so ρ·(f_int − F_ext) is the
         virtual work of the support forces at the nodes: bonds (satisfied by a rigid motion)
-        and interface forces (equal and opposite at a node) drop out."""
+        and interface forces (equal and opposite at a node) drop out. With ``layer`` only that
+        layer moves: the force on it alone, e.g. the opening force on one arm of a DCB whose arms
+        are held apart by prescribed displacements (its interface forces then count: evaluate
+        with the run's problem)."""
         c = self.component
         e = np.eye(3)["xyz".index(c[-1])]
         rho = np.zeros(dm.n_full)
@@ -103,6 +106,8 @@ class Probe:
         X = model.mesh.nodes[nodes]
         A3 = _nodal_normals(model)[nodes] if c.startswith("m") else None
         for k, ly in enumerate(model.layers):
+            if self.layer is not None and k != self.layer:
+                continue
             sel = dm.present[k][nodes]
             if not sel.any():
                 continue
@@ -310,8 +315,10 @@ def _force_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     if pd.component not in allowed:
         raise InputError(f"'{f}.component': a {pd.quantity} probe needs component = one of {list(allowed)} "
                          f"(got {pd.component!r})")
-    unused = {"layer": pd.layer, "theta3": pd.theta3 if pd.theta3 != 0.0 else None,
+    unused = {"theta3": pd.theta3 if pd.theta3 != 0.0 else None,
               "reduce": pd.reduce if pd.reduce != "none" else None}
+    if pd.quantity == "resultant":
+        unused["layer"] = pd.layer
     if pd.quantity == "reaction":
         unused |= {"direction": pd.direction, "about": pd.about}
     else:
@@ -324,7 +331,7 @@ def _force_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     if pd.quantity == "reaction":
         nodes = node_selection(model.mesh, pd, f)
         return Probe(pd.name, pd.quantity, pd.component, pd.measure, empty.astype(np.int64), empty, empty, empty,
-                     None, False, "none", pd.scale, nodes=nodes, unit=pd.unit)
+                     k, False, "none", pd.scale, nodes=nodes, unit=pd.unit)
     if pd.point is None:
         raise InputError(f"'{f}.point': a resultant probe needs a point on the reference surface")
     if pd.direction is None:
