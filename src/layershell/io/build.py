@@ -963,12 +963,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     notes = []
     # prescribed displacements (a fix with a non-zero 'value') load the model as well
     moved = any(getattr(sd, "value", None) and any(v != 0 for v in sd.value) for sd in mf.supports)
-    if moved:
-        pass
-    elif not mf.loads:
+    if not moved and not mf.loads:
         notes.append("the model has no [[loads]], so every displacement, stress and probe value is zero; add a "
                      "[[loads]] table (type = 'surface', 'edge', 'volume', 'gravity' or 'nodal'), see examples/")
-    elif all(_zero_load(ld) for ld in mf.loads):
+    elif not moved and all(_zero_load(ld) for ld in mf.loads):
         notes.append("every [[loads]] entry is zero (magnitude, distribution or value 0), so every displacement, "
                      "stress and probe value is zero; give the loads their values")
     st = mf.steps

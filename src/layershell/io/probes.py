@@ -198,23 +198,26 @@ class Probe:
 
 def residual_forces(model, dm, u: np.ndarray, load_factor: float, problem=None) -> np.ndarray:
     """f_int(u) − F_ext(λ) in the full space: the forces of the constraints (supports, bonds)
-    on the shell. Without a ``problem``, an assembler of the bare elements is kept on the model
-    (contact and friction forces between layers act in equal and opposite pairs at a node and
-    drop out of a reaction); the last result is reused for the same ``u`` (all reaction probes
-    of a step)."""
-    if problem is not None:
-        f, _ = problem.assembler.evaluate(u, tangent=False)
-        return f - problem.external(load_factor)
-    cache = model.__dict__.setdefault("_reaction_cache", {})
-    if cache.get("dm") is not dm:
+    on the shell. With a ``problem``, its assembler (contact, friction and cohesive forces
+    included) and loads; without, an assembler of the bare elements kept on the model (contact
+    and friction forces between layers act in equal and opposite pairs at a node and drop out of
+    a reaction). The last result is reused for the same ``u`` and λ (all reaction probes of a
+    step)."""
+    cache = (model if problem is None else problem).__dict__.setdefault("_reaction_cache", {})
+    if problem is None and cache.get("dm") is not dm:
         from ..assembly import Assembler
         from ..loads import external_forces
 
         cache.clear()
         cache.update(dm=dm, asm=Assembler(model, dm), F=external_forces(model, dm))
     if cache.get("lam") != load_factor or not np.array_equal(cache.get("u"), u):
-        f, _ = cache["asm"].evaluate(u, tangent=False)
-        cache.update(u=u.copy(), lam=load_factor, r=f - (load_factor * cache["F"][0] + cache["F"][1]))
+        if problem is not None:
+            f, _ = problem.assembler.evaluate(u, tangent=False)
+            r = f - problem.external(load_factor)
+        else:
+            f, _ = cache["asm"].evaluate(u, tangent=False)
+            r = f - (load_factor * cache["F"][0] + cache["F"][1])
+        cache.update(u=u.copy(), lam=load_factor, r=r)
     return cache["r"]
 
 
