@@ -159,8 +159,12 @@ def _onset_thesis(B, K, law, cn, cs, lo, hi, lam):
 
 
 # ---------------------------------------------------------------------- damage
-def damage_trial(lam: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw):
-    """d_trial(λ, B) and its partial derivatives ∂d/∂λ, ∂d/∂B (softening law of ``law``)."""
+def damage_trial(lam: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw, extend: bool = False):
+    """d_trial(λ, B) and its partial derivatives ∂d/∂λ, ∂d/∂B (softening law of ``law``).
+    ``extend``: the softening formula also below the onset λ0 (d < 0 there), the
+    smooth continuation that an active-set iteration with a frozen loading set uses (the traction
+    stays on the softening line: no kink at λ0; a point that ends below its onset leaves the
+    loading set)."""
     lam = np.asarray(lam, float)
     l0, dl0 = onset(B, K, law)
     Gc = law.G_c(B)
@@ -183,14 +187,18 @@ def damage_trial(lam: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw):
         lc = (Gc - 0.5 * K * l0**2) / (K * l0)
         dlc = dGc / (K * l0) - Gc / (K * l0**2) * dl0 - 0.5 * dl0
         lc = np.maximum(lc, 1e-12 * l0)
-        ex = np.exp(-np.clip(lam - l0, 0.0, None) / lc)
+        ex = np.exp(-np.clip(lam - l0, -50.0 * lc if extend else 0.0, None) / lc)
         d = 1.0 - l0 / lsafe * ex
-        soft = lam > l0
+        soft = (lam > l0) | extend
         # d = 1 - (l0/λ) e, e = exp(-(λ-l0)/lc)
         dd_l = l0 / lsafe * ex * (1.0 / lsafe + 1.0 / lc)
         dd_l0 = -ex / lsafe - l0 / lsafe * ex / lc
         dd_lc = -l0 / lsafe * ex * (lam - l0) / lc**2
         dd_B = dd_l0 * dl0 + dd_lc * dlc
+    if extend:  # below λ0 the softening formula itself: the traction (1 - d) K λ stays on the
+        # softening line (affine in λ, no kink at λ0), d < 0; bounded where λ → 0
+        soft = (d < 1.0) & (d > -1e3)
+        return np.clip(d, -1e3, 1.0), np.where(soft, dd_l, 0.0), np.where(soft, dd_B, 0.0)
     d = np.where(lam >= l0, np.clip(d, 0.0, 1.0), 0.0)
     return d, np.where(soft, dd_l, 0.0), np.where(soft, dd_B, 0.0)
 
@@ -214,7 +222,8 @@ def separation_measures(delta: np.ndarray, n: np.ndarray):
 
 
 def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float, law: CohesiveLaw,
-                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None):
+                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None,
+                   secant: bool = False):
     """Traction t (..., 3), damage d (...) and the consistent tangent dt/dδ (..., 3, 3) of the
     cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``.
     ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow). ``frozen``:
@@ -232,8 +241,12 @@ def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float
         gv = dnp[..., None] * n + ds
         dlam = gv / ls[..., None] * pos[..., None]
         dB = (2.0 * ds - 2.0 * B[..., None] * gv) / np.where(pos, lam2, 1.0)[..., None] * pos[..., None]
-    dt, dd_l, dd_B = damage_trial(lam, B, K, law)
-    loading = dt > d_old if frozen is None or loading_f is None else loading_f
+    if frozen is not None and loading_f is not None:  # frozen loading set: the smooth continuation
+        dt, dd_l, dd_B = damage_trial(lam, B, K, law, extend=True)
+        loading = loading_f
+    else:
+        dt, dd_l, dd_B = damage_trial(lam, B, K, law)
+        loading = dt > d_old
     d = np.where(loading, dt, d_old)
     # δ_n = 0 counts as tension (the same traction; the tangent of an opening point - a damaged
     # point that starts at δ_n = 0, e.g. an initial crack at u = 0, then opens in one iteration)
@@ -247,7 +260,8 @@ def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float
     dg = np.where(tens[..., None, None], eye, eye - nn)  # ∂g/∂δ
     D = K * eye - (K * d)[..., None, None] * dg
     dd = (dd_l[..., None] * dlam + dd_B[..., None] * dB) * loading[..., None]
-    D = D - K * g[..., :, None] * dd[..., None, :]
+    if not secant:
+        D = D - K * g[..., :, None] * dd[..., None, :]
     return (t, d, D, dd) if with_dd else (t, d, D)
 
 
@@ -298,30 +312,56 @@ class CohesiveBlock:
     lam_old: float = 0.0  # load factor of the last commit
     lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
     last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
+    secant: bool = False  # tangent without the damage-growth term (robust, linear convergence)
     symmetric = False
     compact_tangent = False
+    smooth_when_frozen = True  # newton(): no residual line search in the active-set loop
 
     # ------------------------------------------------------------------ active set (solver/newton.py)
     def gap(self, u_full: np.ndarray) -> np.ndarray:
         """Normal separation δ_n (e, q)."""
         return np.einsum("eqi,eqi->eq", self.separation(u_full), self.contact.A3)
 
+    #: damage tolerance of the loading-set check (a point whose trial damage exceeds its history
+    #: by less counts as not loading; one below its history by less as still loading)
+    LOADING_TOL = 1e-9
+
+    def _trial(self, u_full: np.ndarray):
+        """Normal gap, trial damage (smooth continuation below the onset) at ``u_full``."""
+        delta = self.separation(u_full)
+        n = self.contact.A3
+        _, _, lam, B, _, _ = separation_measures(delta, n)
+        dt, _, _ = damage_trial(lam, B, self.K, self.law, extend=True)
+        return np.einsum("eqi,eqi->eq", delta, n), dt
+
     def freeze(self, u_full: np.ndarray) -> None:
-        """Fix the tension/compression state of every point for the next Newton iterations
-        (the jump of the normal stiffness of a damaged point at δ_n = 0 is the contact-like
-        non-smoothness; the damage growth d = max(d_old, d_trial) stays semi-smooth)."""
+        """Fix the tension/compression state and the loading set (points whose damage grows) of
+        every point for the next Newton iterations: within them the response is smooth (the
+        damage of a loading point follows the softening formula continued below its onset, the
+        others keep their history). The kinks - the onset of damage at λ0, where the normal
+        stiffness drops from K to the softening slope, and the normal stiffness of a damaged
+        point at δ_n = 0 - are then handled by the active-set loop (:func:`~layershell.solver.
+        newton.newton`): semi-smooth Newton across the onset kink can cycle between the states
+        of a few points at the crack tip (DCB, issue 13)."""
         self.frozen = None
-        self.frozen = (self.gap(u_full) >= 0, None)
+        g, dt = self._trial(u_full)
+        loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
+        self.frozen = (g >= 0, loading)
 
     def set_changed(self, u_full: np.ndarray) -> bool:
-        """Does the frozen tension state still hold at the converged ``u_full`` (where it
-        matters: at damaged points, judged without the frozen state)?"""
+        """Do the frozen sets still hold at the converged ``u_full``? Tension: where it matters
+        (damaged points). Loading: a loading point whose damage fell below its history, or a
+        point outside the set whose trial damage exceeds its history. Where a set changed, the
+        next :meth:`freeze` (from ``u_full``) takes the actual sets."""
         if self.frozen is None:
             return False
-        frozen, self.frozen = self.frozen, None
-        _, _, d, _ = self.point_state(u_full)
-        self.frozen = frozen
-        return bool(np.any(((self.gap(u_full) >= 0) != frozen[0]) & (d > 0)))
+        frozen = self.frozen
+        g, dt = self._trial(u_full)
+        tol = self.LOADING_TOL
+        d = np.where(frozen[1], dt, self.d_old)
+        tension_changed = ((g >= 0) != frozen[0]) & (d > 0)
+        loading_changed = np.where(frozen[1], dt < self.d_old - tol, (dt > self.d_old + tol) & (self.d_old < FULL_DAMAGE))
+        return bool(np.any(tension_changed | loading_changed))
 
     def unfreeze(self) -> None:
         self.frozen = None
@@ -362,7 +402,8 @@ class CohesiveBlock:
         ``last_inviscid``)."""
         delta = self.separation(u_full)
         n = self.contact.A3
-        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen)
+        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen,
+                                     secant=self.secant)
         self.last_inviscid = d
         if self.law.viscosity > 0:
             r = max(self.lam_trial - self.lam_old, 0.0) / self.law.viscosity

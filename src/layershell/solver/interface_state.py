@@ -419,10 +419,13 @@ class InterfaceController:
 
     def _path_energies(self, problem, u: np.ndarray, lam: float) -> None:
         """External work and the layers' strain energy as path integrals (trapezoid over the
-        converged states): W = Σ ½(F_k + F_k+1)·(u_k+1 - u_k), U = the same with the layers'
-        internal forces (the internal force less the interface blocks' forces)."""
-        F = problem.external(lam)
+        converged states): W = Σ ½(F_k + F_k+1)·(u_k+1 - u_k) with F the total internal force,
+        which at equilibrium is the applied load plus the support reactions - so W includes the
+        work of prescribed displacements (displacement control; fixed supports and the bond's
+        internal constraint forces do none); U = the same with the layers' internal forces (the
+        internal force less the interface blocks' forces)."""
         f, _ = problem.assembler.evaluate(u, tangent=False)
+        F = f.copy()
         for b in problem.assembler.extra:
             fe, _ = b.response(u, tangent=False)
             f = f - np.bincount(b.dofs.ravel(), weights=fe.ravel(), minlength=f.size)
@@ -448,7 +451,7 @@ class InterfaceController:
         err = W - U - E_itf - frac - fric - visc
         return {"external_work": W, "strain_energy": U, "interface_elastic_energy": E_itf,
                 "dissipated_fracture": frac, "dissipated_friction": fric, "dissipated_viscous": visc,
-                "balance_error": err / W if W != 0 else 0.0}
+                "balance_error": err / max(abs(W), U + E_itf + frac + fric + visc, 1e-300)}
 
 
 def _kin(block):
