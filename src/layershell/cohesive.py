@@ -222,8 +222,7 @@ def separation_measures(delta: np.ndarray, n: np.ndarray):
 
 
 def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float, law: CohesiveLaw,
-                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None,
-                   secant: bool = False):
+                   tangent: bool = True, with_dd: bool = False, frozen: tuple | None = None):
     """Traction t (..., 3), damage d (...) and the consistent tangent dt/dδ (..., 3, 3) of the
     cohesive law at separations ``delta`` (normals ``n``), from the converged damage ``d_old``.
     ``with_dd``: also ∂d/∂δ (..., 3) (zero where the damage does not grow). ``frozen``:
@@ -260,8 +259,7 @@ def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float
     dg = np.where(tens[..., None, None], eye, eye - nn)  # ∂g/∂δ
     D = K * eye - (K * d)[..., None, None] * dg
     dd = (dd_l[..., None] * dlam + dd_B[..., None] * dB) * loading[..., None]
-    if not secant:
-        D = D - K * g[..., :, None] * dd[..., None, :]
+    D = D - K * g[..., :, None] * dd[..., None, :]
     return (t, d, D, dd) if with_dd else (t, d, D)
 
 
@@ -312,7 +310,6 @@ class CohesiveBlock:
     lam_old: float = 0.0  # load factor of the last commit
     lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
     last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
-    secant: bool = False  # tangent without the damage-growth term (robust, linear convergence)
     symmetric = False
     compact_tangent = False
     smooth_when_frozen = True  # newton(): no residual line search in the active-set loop
@@ -402,8 +399,7 @@ class CohesiveBlock:
         ``last_inviscid``)."""
         delta = self.separation(u_full)
         n = self.contact.A3
-        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen,
-                                     secant=self.secant)
+        t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen)
         self.last_inviscid = d
         if self.law.viscosity > 0:
             r = max(self.lam_trial - self.lam_old, 0.0) / self.law.viscosity

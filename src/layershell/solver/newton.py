@@ -82,8 +82,14 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
     if not blocks:
         return newton_fixed_set(problem, u, lam, s)
+    n_semi = min(s.semismooth_iterations, s.max_contact_iterations)
+    if all(getattr(b, "smooth_when_frozen", False) for b in blocks):
+        # cohesive interfaces: semi-smooth iterations cycle at the onset of damage (the kink
+        # at λ0); the active-set loop converges there, and as fast on the easy steps (DCB to
+        # δ = 10 mm: 590 iterations against 879 with 8 semi-smooth ones first)
+        n_semi = min(n_semi, COHESIVE_SEMISMOOTH)
     total = NewtonResult(False, 0)
-    if s.semismooth_iterations > 0:
+    if n_semi > 0:
         for b in blocks:
             b.unfreeze()
         seen: set[bytes] = set()
@@ -97,11 +103,6 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             last = key
             return again
 
-        n_semi = min(s.semismooth_iterations, s.max_contact_iterations)
-        if all(getattr(b, "smooth_when_frozen", False) for b in blocks):
-            # cohesive interfaces: an easy step converges in a few semi-smooth iterations; at the
-            # onset of damage they cycle (the kink at λ0), and the active-set loop is the cure
-            n_semi = min(n_semi, COHESIVE_SEMISMOOTH)
         u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=n_semi),
                                       give_up_after=6, give_up_if=cycling)
         if res.converged:
@@ -141,7 +142,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
 
 
 #: semi-smooth iterations before the active-set loop on models whose interfaces are all cohesive
-COHESIVE_SEMISMOOTH = 8
+COHESIVE_SEMISMOOTH = 0
 
 
 def _contact_cap_message(iterations: int) -> str:
