@@ -94,8 +94,8 @@ def test_dcb_peak_under_force_control_against_corrected_beam_theory():
     """Under force control the DCB (150 elements, 9 node spacings in the process zone) runs to
     its peak and stops there. The peak state lies on the corrected-beam-theory propagation curve:
     the load is within 3 % of P_CBT at the crack length inferred from the state's compliance
-    (measured: 60.0 N at the last completed step against 61.4 N, -2.2 %), and the crack has
-    started to grow (a = 56.7 mm). (The beam-theory load at the initial crack, 63.1 N, is 4.9 %
+    (measured: 62.0 N at the last completed step against 60.6 N, +2.3 %), and the crack has
+    started to grow (a = 57.4 mm). (The beam-theory load at the initial crack, 63.1 N, is 4.9 %
     higher: the process zone has already moved the effective crack tip.)"""
     r = run_example("dcb_cohesive")
     assert not r.summary["converged"]  # force control cannot pass the peak
@@ -107,28 +107,55 @@ def test_dcb_peak_under_force_control_against_corrected_beam_theory():
     assert abs(e["balance_error"]) < 0.01
 
 
-@pytest.mark.skip(reason="Newton does not converge at the onset of crack growth: under displacement control "
-                         "(DISPLACEMENT_CONTROL, adaptive steps) the run stops at δ = 4.23 mm, P = 58.6 N, just "
-                         "below the peak (150-200 iterations per step from P = 58.2 N on; the same with the MITC9 "
-                         "element at 58.4 N); arc length on the force loads stalls at the same point (issue 13, "
-                         "closing note)")
-def test_dcb_propagation_branch_against_corrected_beam_theory():
-    """Propagation branch under displacement control: at every point past the peak, the load
-    is within 3 % of the beam-theory load P(a) at the crack length a that corrected beam theory
-    infers from the secant compliance C = δ/P (Williams 1989).
-
-    To switch on once the Newton iterations at the crack-growth onset converge: the example with
-    DISPLACEMENT_CONTROL and adaptive steps to δ = 10 mm."""
-    r = run_example("dcb_cohesive", {**DISPLACEMENT_CONTROL, "factors = [0.01, 0.02, 0.05,": "n = 100\nadaptive = true\n"
-                                     "increment_max = 0.02 #"})
+def displacement_controlled(nx: int):
+    """examples/dcb_cohesive.toml with ``nx`` elements along its length, opened under
+    displacement control (DISPLACEMENT_CONTROL) to δ = 10 mm with adaptive steps: the load P
+    (reaction on the upper arm), the opening δ and the summary."""
+    r = run_example("dcb_cohesive", {**DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}",
+                                     "factors = [0.01, 0.02, 0.05,": "n = 100\nadaptive = true\nincrement_max = 0.02 #"})
     steps = r.summary["steps"]
     P = np.array([s["probes"]["P"] for s in steps])
     d = np.array([opening(s) for s in steps])
+    return P, d, r.summary
+
+
+@pytest.fixture(scope="module")
+def dcb_200():
+    """The displacement-controlled DCB on 200 elements (node spacing 0.375 mm; the process zone,
+    about 2 mm between the onset and full damage, spans 5 of them)."""
+    return displacement_controlled(200)
+
+
+def cbt_load_at(P: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Beam-theory load P(a) at the crack length that corrected beam theory infers from the
+    secant compliance C = δ/P of each state (Williams 1989)."""
+    a_plus = (d / P * E11 * B * H**3 / 8) ** (1 / 3)  # a + χh
+    return B / a_plus * np.sqrt(GIC * E11 * H**3 / 12)
+
+
+@pytest.mark.slow
+def test_dcb_propagation_branch_against_corrected_beam_theory(dcb_200):
+    """Propagation branch under displacement control (200 elements): the run opens the DCB to
+    δ = 10 mm (the crack grows from 55 to about 84 mm), and at every state past the peak the load is
+    within 3 % of the beam-theory load at the crack length inferred from its compliance
+    (measured: within -0.3 ... +1.8 %, a saw-tooth as the front passes node by node; on 150
+    elements -0.1 ... +3.0 %). The energy dissipated by fracture equals G_Ic times the crack area that beam
+    theory infers from the final compliance, within 3 % (the crack front is a process zone,
+    not a line)."""
+    P, d, summary = dcb_200
+    assert summary["converged"] and d[-1] == pytest.approx(10.0, rel=1e-3)
     peak = int(np.argmax(P))
-    assert peak < len(P) - 3, "no propagation branch traced"
-    for Pi, di in zip(P[peak + 1:], d[peak + 1:]):
-        a_plus = (di / Pi * E11 * B * H**3 / 8) ** (1 / 3)  # a + χh from the compliance
-        assert Pi == pytest.approx(B / a_plus * np.sqrt(GIC * E11 * H**3 / 12), rel=0.03)
+    assert peak < len(P) - 10, "no propagation branch traced"
+    ratio = P[peak + 1:] / cbt_load_at(P[peak + 1:], d[peak + 1:])
+    assert np.all(np.abs(ratio - 1) < 0.03), ratio
+    a_end = (d[-1] / P[-1] * E11 * B * H**3 / 8) ** (1 / 3) - chi() * H
+    assert a_end > 75.0
+    e = summary["energy"]
+    assert e["dissipated_fracture"] == pytest.approx(GIC * B * (a_end - A0), rel=0.03)  # measured -1.6 %
+    # external work (the reaction's work on the prescribed opening, trapezoid over the steps) =
+    # strain energy + interface energy + dissipation: measured 0.9 % (the trapezoid over-counts
+    # the steps in which the load drops as the front passes a node; 1.9 % on 150 elements)
+    assert abs(e["balance_error"]) < 0.01
 
 
 def _tractions_ahead_of_tip(rule: str):

@@ -274,7 +274,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 / 1000.0
     dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * l0
     inc_max = ps.increment_max if ps.increment_max is not None else 10.0 * ps.increment
-    inc_min = ps.increment * 0.5**ps.max_cuts
+    # the smallest Δλ: well below what max_cuts halvings of the first increment reach, since the
+    # step-size control may already have shrunk the increment before a failure (a DCB's crack
+    # advancing node by node needs 20-40 iterations a step, and each such step halves it)
+    inc_min = ps.increment * 0.5 ** (ps.max_cuts + 8)
     area_prev = measure(problem) if measure is not None else None
     probes_prev = watch(u, lam) if watch is not None else None
     end = ps.lambda_end

@@ -77,7 +77,13 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     during the iterations, then checked), at most ``max_contact_iterations`` iterations in all.
     Both use the residual line search for contact (full Newton steps in the semi-smooth phase
     cut the pull-off's time by about 10 % but took 2.5× the iterations in the §5.1 plate's first
-    debonding step and failed there without any line search)."""
+    debonding step and failed there without any line search).
+
+    Cohesive interfaces (blocks with ``smooth_when_frozen``): no semi-smooth phase (it cycles at
+    the kink of the law at the onset of damage); the active-set loop freezes the tension state
+    and the loading set, iterates with full Newton steps on the then smooth problem, and a set
+    that has not settled after ``max_active_set_loops`` is a failure (the step is cut), not an
+    accepted state."""
     u = problem.impose(u, lam)  # prescribed displacements at this load factor (displacement control)
     blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
     if not blocks:
@@ -134,7 +140,9 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             total.converged = True
             break
     else:
-        total.converged = True  # the set cycles between equivalent states: accept the last
+        # contact: the set cycles between equivalent states, accept the last; a cohesive loading
+        # set that still changes is not an equilibrium of the damage law (cut the step)
+        total.converged = not any(getattr(b, "smooth_when_frozen", False) for b in blocks)
         total.message = "contact set still changing after the allowed active-set loops"
     for b in blocks:
         b.unfreeze()
