@@ -189,7 +189,7 @@ def damage_trial(lam: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw, ext
         lc = np.maximum(lc, 1e-12 * l0)
         ex = np.exp(-np.clip(lam - l0, -50.0 * lc if extend else 0.0, None) / lc)
         d = 1.0 - l0 / lsafe * ex
-        soft = (lam > l0) | extend
+        soft = lam > l0
         # d = 1 - (l0/λ) e, e = exp(-(λ-l0)/lc)
         dd_l = l0 / lsafe * ex * (1.0 / lsafe + 1.0 / lc)
         dd_l0 = -ex / lsafe - l0 / lsafe * ex / lc
@@ -340,7 +340,6 @@ class CohesiveBlock:
         point at δ_n = 0 - are then handled by the active-set loop (:func:`~layershell.solver.
         newton.newton`): semi-smooth Newton across the onset kink can cycle between the states
         of a few points at the crack tip (DCB, issue 13)."""
-        self.frozen = None
         g, dt = self._trial(u_full)
         loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
         self.frozen = (g >= 0, loading)
