@@ -118,14 +118,31 @@ def onset(B: np.ndarray, K: float, law: CohesiveLaw) -> tuple[np.ndarray, np.nda
         dq = -1.0 / N**2 + 1.0 / S**2
         return lam0, -0.5 * lam0 * dq / q
     # thesis (4.15): g(λ, B) = K λ cs - S (1 - K λ cn / N)^(1/p) = 0, increasing in λ; root in
-    # [0, N/(K cn)] (the tensile cut-off (4.20)) - Newton from the bracket's side, safeguarded
+    # [0, N/(K cn)] (the tensile cut-off (4.20))
     p = law.p
+    if p in (1.0, 2.0):
+        return _onset_thesis_closed(B, K, law, cn, cs)
+    # other exponents: Newton from the bracket's side, safeguarded
     hi = np.where(cn > 0, N / (K * np.maximum(cn, 1e-300)), S / K * 1.0)
     hi = np.where(cs > 0, np.minimum(hi, S / (K * np.maximum(cs, 1e-300))), hi)  # g(S/(K cs)) >= 0
     lo = np.zeros_like(B)
     lam = 0.5 * (lo + hi)
     with np.errstate(all="ignore"):
         return _onset_thesis(B, K, law, cn, cs, lo, hi, lam)
+
+
+def _onset_thesis_closed(B, K, law, cn, cs):
+    """The thesis's onset for p = 1 or 2 in closed form (x = K λ0):
+    p = 2: cs² x² + (S² cn/N) x - S² = 0, taken as x = 2S² / (S² cn/N + sqrt((S² cn/N)² + 4 cs² S²))
+    (no cancellation; x = N/cn, the tensile cut-off, in pure mode I);
+    p = 1: cs x = S (1 - x cn/N), x = S / (cs + S cn/N)."""
+    N, S = law.sigma_max, law.tau_max
+    a = S * cn / N
+    if law.p == 2.0:
+        x = 2.0 * S**2 / (S * a + np.sqrt((S * a) ** 2 + 4.0 * cs**2 * S**2))
+    else:
+        x = S / (cs + a)
+    return _onset_derivative(B, K, law, cn, cs, x / K)
 
 
 def _onset_thesis(B, K, law, cn, cs, lo, hi, lam):
@@ -145,6 +162,12 @@ def _onset_thesis(B, K, law, cn, cs, lo, hi, lam):
             lam = new
             break
         lam = new
+    return _onset_derivative(B, K, law, cn, cs, lam)
+
+
+def _onset_derivative(B, K, law, cn, cs, lam):
+    """(λ0, dλ0/dB) of the thesis's onset at its root ``lam``."""
+    N, S, p = law.sigma_max, law.tau_max, law.p
     base = np.clip(1.0 - K * lam * cn / N, 0.0, None)
     # implicit derivative dλ/dB = -g_B / g_λ, with dcn/dB = -1/(2 cn), dcs/dB = 1/(2 cs)
     with np.errstate(all="ignore"):

@@ -17,6 +17,7 @@ from .io.build import RunSpec
 from .recorder import Recorder, read_history
 from .solver.newton import ConvergenceError, DebondCut, load_steps
 from .solver.problem import Problem
+from .threads import openblas_single_thread
 
 
 def through_thickness(spec_profile, model, dm, u, load_factor: float = 1.0):
@@ -270,14 +271,15 @@ def run(spec: RunSpec, out: Path | None = None, progress: Callable[[int, int, fl
     are written.
     """
     ck = checkpoint.load(restart) if restart is not None else None  # a bad folder fails before the build
-    if out is None:
-        return _run(spec, None, progress, write_vtu, restart, ck, monitor)
-    out = Path(out)
-    resume = restart is not None and checkpoint.locate(restart).parent.resolve() == out.resolve()
-    with Recorder(out, model_file=str(Path(spec.path).resolve()) if spec.path is not None else None,
-                  model_hash=checkpoint.model_hash(spec), title=spec.source.model.title,
-                  overwrite=overwrite, resume=resume, echo=echo) as rec:
-        return _run(spec, rec, progress, write_vtu, restart, ck, monitor)
+    with openblas_single_thread():  # vector BLAS on one thread (layershell/threads.py)
+        if out is None:
+            return _run(spec, None, progress, write_vtu, restart, ck, monitor)
+        out = Path(out)
+        resume = restart is not None and checkpoint.locate(restart).parent.resolve() == out.resolve()
+        with Recorder(out, model_file=str(Path(spec.path).resolve()) if spec.path is not None else None,
+                      model_hash=checkpoint.model_hash(spec), title=spec.source.model.title,
+                      overwrite=overwrite, resume=resume, echo=echo) as rec:
+            return _run(spec, rec, progress, write_vtu, restart, ck, monitor)
 
 
 def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, monitor) -> RunResult:
