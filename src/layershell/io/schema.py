@@ -563,6 +563,11 @@ class InterfaceDef(Strict):
         None, description="cohesive: initial penalty stiffness per area in the normal and tangential directions "
                           "(stress/length; default alpha · E3/H of the thinner adjacent layer, Turon et al. 2007)")
     alpha: PositiveFloat = Field(50.0, description="cohesive: factor α of the default K0 = α E3/H")
+    K0_check: bool = Field(
+        True, description="cohesive: refuse a K0 that makes the interface more than 3 % as compliant as the two "
+                          "layers (a penalty that softens the bonded structure); false where K0 is the measured "
+                          "elastic stiffness of the bond itself, e.g. τ_f/δ_1 of a bond-slip law, whose slip is "
+                          "part of the physics (examples/lapshear_cohesive.toml)")
     viscosity: float = Field(
         0.0, ge=0, description="cohesive: viscous regularisation time η in load-factor units (Gao & Bower 2004; 0 = "
                                "off): the damage follows the rate-independent one with ḋ = (d_inviscid - d)/η; its "
