@@ -405,7 +405,9 @@ class Steps(Strict):
         None, description="control = 'arc_length': the smallest arc length before the run stops (default "
         "arc_length/1000)")
     arc_length_max: PositiveFloat | None = Field(
-        None, description="control = 'arc_length': the largest arc length (default 10 × arc_length)")
+        None, description="control = 'arc_length': the largest arc length (default 10 × arc_length); "
+        "it also bounds the increments under the dissipation constraint (the next dissipation increment is "
+        "scaled down where an increment was longer)")
     dissipation: bool = Field(
         True, description="control = 'arc_length': switch to the dissipation-based constraint (Gutiérrez 2004; "
         "Verhoosel, Remmers & Gutiérrez 2009) once an increment dissipates energy (damage with secant unloading)")

@@ -429,9 +429,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             elastic = 0.5 * abs(att.lam * float(problem.F_scaled @ att.u))
             if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > 0:
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
-        else:
-            st.size = st.size * fac
-            st.arc_length = max(min(float(np.linalg.norm(du[problem.op.independent])), dl_max), dl_min)
+        else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
+            # down where this one was longer (else a short bond's peak lies inside one increment)
+            dun = float(np.linalg.norm(du[problem.op.independent]))
+            st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
+            st.arc_length = max(min(dun, dl_max), dl_min)
         st.du_prev = du
         st.changed = resolves > 0
         u, lam = att.u, att.lam
