@@ -222,6 +222,29 @@ def test_eccentricity_is_pure_mode_ii_at_the_peak(short_bonds, full_path):
     assert strong["peak"] == pytest.approx(JOINT.peak_load(50.0), rel=0.003)
 
 
+def test_dissipation_constraint_acts_on_a_cohesive_interface():
+    """Regression (issue 13, found with this test): at a converged state with damage, an
+    increment under the dissipation constraint converges and dissipates the prescribed energy.
+    Before arc_attempt froze the cohesive loading set, the predictor tangent at a converged state
+    was the secant one (no point counted as loading at d = d_old), the predictor dissipated
+    nothing and every such increment was refused ("no dissipation in the predictor direction")."""
+    from layershell.solver.arclength import arc_attempt, dissipation_increment
+
+    spec = build(parse(model_text(100.0), "lapshear"), EXAMPLES)
+    pb = Problem.build(spec.model)
+    ctl = pb.interfaces
+    for st in path_steps(pb, spec.newton, spec.path_following, on_step_end=lambda p, u, lam: ctl.update(p, u, lam)):
+        if st.state.mode == "dissipation":  # the first increment that dissipated (damage grows)
+            break
+    assert pb.extra_blocks[0].d_old.max() > 0
+    u0, lam0 = st.u, st.load_factor
+    size = 0.5 * st.dissipation
+    att = arc_attempt(pb, u0, lam0, size, "dissipation", None, spec.newton, spec.path_following, lam0)
+    assert att.converged, att.message
+    assert dissipation_increment(pb, u0, lam0, att.u - u0, att.lam - lam0) == pytest.approx(size, rel=1e-6)
+    assert not any(getattr(b, "frozen", None) for b in pb.extra_blocks)  # unfrozen afterwards
+
+
 @pytest.mark.slow
 def test_peak_converges_with_the_mesh():
     """Peak of the L = 100 mm bond (below L_e, where the peak is sharpest) on elements of 20, 10,
