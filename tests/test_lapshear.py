@@ -11,14 +11,20 @@ Eccentricity. The shell strip is pulled at its cross-section while the bond acts
 face; the couple P t_p/2 bends the strip, which the 1D shear-lag model of the reference ignores.
 The couple is carried by peel tractions: compression at the loaded end (up to 0.96 MPa, 19 % of
 τ_f, at the onset of damage; compression never damages), tension of at most 0.06 MPa ahead of
-the process zone and, from the peak on, at the free end, which lifts: 0.11 MPa (2.2 % of τ_f,
-3.6 % of σ_max) at the peak, growing after it. The mode ratio B = G_II/G of every damaged point stays
-above 0.9998 up to the peak (measured), so G_c(B) differs from G_IIc by less than 3·10⁻⁴ and
-the onset from τ_f likewise: the eccentricity does not matter for the peak load
-(test_eccentricity_is_pure_mode_ii_at_the_peak checks it). What it does change is the slip at
-the loaded end, measured on the strip's bottom face: the bending rotation adds about 0.7 % to it
-at the peak. The loads at a given free-end slip (where the strip's end is straight) agree to
-0.1-0.7 % before the peak.
+the process zone and, from the peak on, at the free end, which lifts. On the example's long bond
+(L = 250 mm) that is 0.11 MPa (2.2 % of τ_f, 3.6 % of σ_max) at the peak, and the mode ratio
+B = G_II/G of every softening point stays above 0.9998 up to the peak: G_c(B) differs from G_IIc
+by less than 3·10⁻⁴, and the onset of the thesis's criterion (4.15), which falls with the peel
+σ as sqrt(1 - σ/σ_max), by at most 1 % at the most peeled point; the long-bond peak is set by
+G_f (P_u = b_p √(2 G_f E_p t_p)), so there the eccentricity does not matter (within 0.1 % from
+L = 100 mm on). A short bond (L = 50 mm, 0.3 L_e) lifts its free
+end harder: peel 0.88 MPa (29 % of σ_max) at the peak, B down to 0.954, and the peak is 0.85 %
+below the closed form. The independent check that this is the eccentricity and not the
+discretisation: the same model with a peel strength and G_Ic that cannot act is within 0.3 %, and
+the peak does not move with the mesh (test_eccentricity_is_pure_mode_ii_at_the_peak). This is
+physics of the shell model, not a defect: it is not constrained away. The bending also moves the
+slips, taken on the strip's bottom face, against the bar of the reference: by up to 1.2 % of δ_f
+at the loaded end; the load at a given free-end slip agrees within 0.7 % of P_u (L = 250 mm).
 """
 from __future__ import annotations
 
@@ -207,7 +213,7 @@ def test_eccentricity_is_pure_mode_ii_at_the_peak(short_bonds, full_path):
     so the free end softens earlier and the peak is 0.85 % below the closed form. Independent
     check that this is the eccentricity and not the discretisation: the same model with a peel
     strength and G_Ic that cannot act (σ_max = 100 τ_f, G_Ic = G_IIc) is within 0.3 % of the
-    closed form."""
+    closed form (measured -0.2 %), and on elements of half the length the peak stays."""
     o = full_path
     i = int(np.argmax(o["P"]))
     assert max(x[0] for x in o["itf"][:i + 1]) < 0.03 * TAU_F
@@ -220,6 +226,8 @@ def test_eccentricity_is_pure_mode_ii_at_the_peak(short_bonds, full_path):
     assert -0.015 < dev < -0.005
     strong = trace(50.0, 5.0, extra={"sigma_max = 3.0": "sigma_max = 495.1", "G_Ic = 0.14": f"G_Ic = {G_F}"})
     assert strong["peak"] == pytest.approx(JOINT.peak_load(50.0), rel=0.003)
+    # and not the mesh: half the element length moves the short bond's peak by 0.02 % (measured)
+    assert trace(50.0, 2.5)["peak"] == pytest.approx(s["peak"], rel=0.001)
 
 
 def test_dissipation_constraint_acts_on_a_cohesive_interface():
