@@ -635,11 +635,12 @@ def _cohesive_law(idf, f: str, gT: float, model, upper: int, lower: int):
     itf = Interface(upper, lower, "", np.zeros(0, int))
     K = law.K0 if law.K0 is not None else default_cohesive_stiffness(model, itf, law)
     soft = cohesive_softening_estimate(model, itf, K)
-    if soft > 0.03:
+    if soft > 0.03 and idf.K0_check:
         raise InputError(f"'{f}.K0' = {K:.4g}: this penalty stiffness makes the interface {100 * soft:.3g} % as "
                          "compliant as the two layers through their thickness, so it softens the bonded structure by "
                          "more than a few percent; raise K0 (or leave it out for the default alpha · E3/H, Turon et "
-                         "al. 2007)")
+                         "al. 2007), or set K0_check = false if K0 is the elastic stiffness of the bond itself "
+                         "(τ_f/δ_1 of a bond-slip law)")
     K_ref = default_cohesive_stiffness(model, itf, replace(law, alpha=1.0))
     if K > 1e5 * K_ref:
         raise InputError(f"'{f}.K0' = {K:.4g} is more than 1e5 × E3/H of the adjacent layers ({K_ref:.4g}): such a "

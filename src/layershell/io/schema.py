@@ -405,7 +405,9 @@ class Steps(Strict):
         None, description="control = 'arc_length': the smallest arc length before the run stops (default "
         "arc_length/1000)")
     arc_length_max: PositiveFloat | None = Field(
-        None, description="control = 'arc_length': the largest arc length (default 10 × arc_length)")
+        None, description="control = 'arc_length': the largest arc length (default 10 × arc_length); "
+        "it also bounds the increments under the dissipation constraint (the next dissipation increment is "
+        "scaled down where an increment was longer)")
     dissipation: bool = Field(
         True, description="control = 'arc_length': switch to the dissipation-based constraint (Gutiérrez 2004; "
         "Verhoosel, Remmers & Gutiérrez 2009) once an increment dissipates energy (damage with secant unloading)")
@@ -563,6 +565,11 @@ class InterfaceDef(Strict):
         None, description="cohesive: initial penalty stiffness per area in the normal and tangential directions "
                           "(stress/length; default alpha · E3/H of the thinner adjacent layer, Turon et al. 2007)")
     alpha: PositiveFloat = Field(50.0, description="cohesive: factor α of the default K0 = α E3/H")
+    K0_check: bool = Field(
+        True, description="cohesive: refuse a K0 that makes the interface more than 3 % as compliant as the two "
+                          "layers (a penalty that softens the bonded structure); false where K0 is the measured "
+                          "elastic stiffness of the bond itself, e.g. τ_f/δ_1 of a bond-slip law, whose slip is "
+                          "part of the physics (examples/lapshear_cohesive.toml)")
     viscosity: float = Field(
         0.0, ge=0, description="cohesive: viscous regularisation time η in load-factor units (Gao & Bower 2004; 0 = "
                                "off): the damage follows the rate-independent one with ḋ = (d_inviscid - d)/η; its "

@@ -130,18 +130,42 @@ def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.
     return 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
 
 
-def _contact_blocks(problem: Problem) -> None:
+def _contact_blocks(problem: Problem, u0: np.ndarray) -> list:
+    """Contact blocks: set from the current gap in every iteration (semi-smooth). Cohesive blocks
+    (``smooth_when_frozen``): tension state and loading set frozen at ``u0`` (returned), as in
+    the active-set loop of :func:`~layershell.solver.newton.newton` - unfrozen, the tangent at a
+    converged state is the secant one (no point counts as loading at d = d_old), so the
+    dissipation constraint sees no dissipation in the predictor, and the semi-smooth iterations
+    cycle between two loading sets past a snap-back (single-lap shear, tests/test_lapshear.py)."""
+    cohesive = []
     for b in problem.assembler.extra:
-        if hasattr(b, "unfreeze"):
-            b.unfreeze()  # contact set from the current gap in every iteration (semi-smooth)
+        if getattr(b, "smooth_when_frozen", False):
+            b.freeze(u0)
+            cohesive.append(b)
+        elif hasattr(b, "unfreeze"):
+            b.unfreeze()
+    return cohesive
 
 
 def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
                 du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float) -> Attempt:
     """One increment from the equilibrium (u0, λ0) under the arc-length (``mode = "arc"``, Δl =
-    ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``)."""
+    ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``). Cohesive
+    interfaces: an active-set loop (sets frozen during the iterations; a converged state whose
+    sets changed is iterated on with the sets frozen anew, at most ``max_active_set_loops``
+    times)."""
+    cohesive = _contact_blocks(problem, u0)
+    try:
+        return _arc_attempt(problem, u0, lam0, size, mode, du_prev, s, ps, lam_ref, cohesive)
+    finally:
+        for b in cohesive:
+            b.unfreeze()
+
+
+def _arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
+                 du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float,
+                 cohesive: list) -> Attempt:
     op, asm = problem.op, problem.assembler
-    _contact_blocks(problem)
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
     nq = math.sqrt(qq)
@@ -167,7 +191,10 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             return att
         dlam = size / den
     dur = dlam * dut
-    for it in range(s.max_iterations + 1):
+    loops, it0 = 0, 0  # active-set loops (cohesive), first iteration of the current loop
+    it_max = s.max_iterations if not cohesive else min(s.max_contact_iterations,
+                                                        s.max_iterations * s.max_active_set_loops)
+    for it in range(it_max + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
         f, _ = asm.evaluate(u, tangent=False)  # the tangent only where an iteration follows
@@ -180,9 +207,19 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             return att
         scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
         if it > 0 and rn <= s.tol_residual * scale:
-            att.converged = True
-            return att
-        if it == s.max_iterations:
+            if not any(b.set_changed(u) for b in cohesive):
+                att.converged = True
+                return att
+            loops += 1
+            if loops >= s.max_active_set_loops:
+                att.message = "cohesive loading set still changing after the allowed active-set loops"
+                return att
+            for b in cohesive:  # the actual sets at u, and iterate on under the same constraint
+                b.freeze(u)
+            it0 = it
+            f, _ = asm.evaluate(u, tangent=False)
+            r = op.reduce(problem.external(lam) - f)
+        if it == it_max or it - it0 >= s.max_iterations:
             break
         try:
             _, Kr = asm.evaluate_reduced(u, op)
@@ -218,7 +255,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             dl = -g / dg
         dur = dur + a + dl * b
         dlam += dl
-    att.message = f"no convergence in {s.max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
+    att.message = f"no convergence in {att.iterations} iterations (last residual {att.residuals[-1]:.3e})"
     return att
 
 
@@ -392,9 +429,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             elastic = 0.5 * abs(att.lam * float(problem.F_scaled @ att.u))
             if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > 0:
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
-        else:
-            st.size = st.size * fac
-            st.arc_length = max(min(float(np.linalg.norm(du[problem.op.independent])), dl_max), dl_min)
+        else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
+            # down where this one was longer (else a short bond's peak lies inside one increment)
+            dun = float(np.linalg.norm(du[problem.op.independent]))
+            st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
+            st.arc_length = max(min(dun, dl_max), dl_min)
         st.du_prev = du
         st.changed = resolves > 0
         u, lam = att.u, att.lam
