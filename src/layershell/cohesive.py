@@ -354,7 +354,14 @@ class CohesiveBlock:
         dt, _, _ = damage_trial(lam, B, self.K, self.law, extend=True)
         return np.einsum("eqi,eqi->eq", delta, n), dt
 
-    def freeze(self, u_full: np.ndarray) -> None:
+    def actual_sets(self, u_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(tension, loading) of every point at ``u_full``: δ_n >= 0, and the points whose damage
+        grows (trial damage, continued below the onset, above the history)."""
+        g, dt = self._trial(u_full)
+        loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
+        return g >= 0, loading
+
+    def freeze(self, u_full: np.ndarray, limited: bool = False) -> None:
         """Fix the tension/compression state and the loading set (points whose damage grows) of
         every point for the next Newton iterations: within them the response is smooth (the
         damage of a loading point follows the softening formula continued below its onset, the
@@ -362,10 +369,24 @@ class CohesiveBlock:
         stiffness drops from K to the softening slope, and the normal stiffness of a damaged
         point at δ_n = 0 - are then handled by the active-set loop (:func:`~layershell.solver.
         newton.newton`): semi-smooth Newton across the onset kink can cycle between the states
-        of a few points at the crack tip (DCB, issue 13)."""
-        g, dt = self._trial(u_full)
-        loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
-        self.frozen = (g >= 0, loading)
+        of a few points at the crack tip (DCB, issue 13).
+
+        ``limited``: change the frozen loading set only at the points that violate it most
+        (those within 1e-6 of the largest |d_trial - d_old| among the points whose state
+        changed; symmetric points flip together). Flipping every violated point at once can
+        cycle between two sets neither of which is consistent - near a crack front passing a
+        node, all points of the front loading unloads two of them, and without those they load
+        again - while a set in between is (the standard remedy for a cycling primal-dual active
+        set, cf. Hintermüller, Ito & Kunisch 2002)."""
+        tension, loading = self.actual_sets(u_full)
+        if limited and self.frozen is not None and self.frozen[1] is not None:
+            prev = self.frozen[1]
+            _, dt = self._trial(u_full)
+            viol = np.where(loading != prev, np.abs(dt - self.d_old), 0.0)
+            worst = float(viol.max())
+            if worst > 0.0:
+                loading = np.where(viol >= (1.0 - 1e-6) * worst, loading, prev)
+        self.frozen = (tension, loading)
 
     def set_changed(self, u_full: np.ndarray) -> bool:
         """Do the frozen sets still hold at the converged ``u_full``? Tension: where it matters

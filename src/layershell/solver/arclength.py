@@ -35,7 +35,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import ConvergenceError, NewtonSettings, StepResult, newton
+from .newton import ConvergenceError, NewtonSettings, StepResult, freeze_sets, newton
 from .problem import Problem
 
 
@@ -130,46 +130,36 @@ def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.
     return 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
 
 
-def _contact_blocks(problem: Problem, u0: np.ndarray) -> list:
-    """Contact blocks: set from the current gap in every iteration (semi-smooth). Cohesive blocks
-    (``smooth_when_frozen``): tension state and loading set frozen at ``u0`` (returned), as in
-    the active-set loop of :func:`~layershell.solver.newton.newton` - unfrozen, the tangent at a
-    converged state is the secant one (no point counts as loading at d = d_old), so the
-    dissipation constraint sees no dissipation in the predictor, and the semi-smooth iterations
-    cycle between two loading sets past a snap-back (single-lap shear, tests/test_lapshear.py)."""
-    cohesive = []
-    for b in problem.assembler.extra:
-        if getattr(b, "smooth_when_frozen", False):
-            b.freeze(u0)
-            cohesive.append(b)
-        elif hasattr(b, "unfreeze"):
-            b.unfreeze()
-    return cohesive
+def _frozen_blocks(problem: Problem) -> list:
+    """The blocks with an active set. Contact: taken from the current gap in every iteration
+    (semi-smooth; unfrozen here). Cohesive interfaces (``smooth_when_frozen``): returned, for the
+    active-set loop of :func:`arc_attempt`, as in :func:`~layershell.solver.newton.newton` (the
+    semi-smooth iteration cycles at the kink of the law at the onset of damage)."""
+    blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
+    for b in blocks:
+        b.unfreeze()
+    if blocks and all(getattr(b, "smooth_when_frozen", False) for b in blocks):
+        return blocks
+    return []
 
 
 def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
                 du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float) -> Attempt:
     """One increment from the equilibrium (u0, λ0) under the arc-length (``mode = "arc"``, Δl =
-    ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``). Cohesive
-    interfaces: an active-set loop (sets frozen during the iterations; a converged state whose
-    sets changed is iterated on with the sets frozen anew, at most ``max_active_set_loops``
-    times)."""
-    cohesive = _contact_blocks(problem, u0)
-    try:
-        return _arc_attempt(problem, u0, lam0, size, mode, du_prev, s, ps, lam_ref, cohesive)
-    finally:
-        for b in cohesive:
-            b.unfreeze()
+    ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``).
 
-
-def _arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
-                 du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float,
-                 cohesive: list) -> Attempt:
+    Cohesive interfaces: an active-set loop around the constrained iterations, as in
+    :func:`~layershell.solver.newton.newton`. The tension state and the loading set are frozen
+    at u0 (the points softening there keep softening in the predictor), the constrained Newton
+    iterations converge on the then smooth problem, the sets are checked at the solution and,
+    where they changed, frozen there and the same increment iterated on, at most
+    ``max_active_set_loops`` times."""
     op, asm = problem.op, problem.assembler
+    blocks = _frozen_blocks(problem)
+    seen: set[bytes] = set()
+    freeze_sets(blocks, u0, seen)
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
-    nq = math.sqrt(qq)
-    Fc_r = op.reduce(problem.F_const)
     solver = problem.linear_solver(s.backend)
     att = Attempt(False, u0, lam0, 0)
     try:
@@ -177,7 +167,7 @@ def _arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mod
         dut = solver.solve(Kr, q)
     except linear.SingularSystemError as exc:
         att.message = f"singular tangent ({exc})"
-        return att
+        return _unfrozen(att, blocks)
     dUt = op.expand(dut)
     if mode == "arc":
         dlam = size / math.sqrt(float(dut @ dut) + ps.psi**2 * qq)
@@ -188,45 +178,66 @@ def _arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mod
         den = 0.5 * (lam0 * float(F @ dUt) - float(F @ u0))
         if abs(den) <= 1e-6 * 0.5 * (abs(lam0 * float(F @ dUt)) + abs(float(F @ u0))):
             att.message = "no dissipation in the predictor direction"
-            return att
+            return _unfrozen(att, blocks)
         dlam = size / den
     dur = dlam * dut
-    loops, it0 = 0, 0  # active-set loops (cohesive), first iteration of the current loop
-    it_max = s.max_iterations if not cohesive else min(s.max_contact_iterations,
-                                                        s.max_iterations * s.max_active_set_loops)
-    for it in range(it_max + 1):
+    for loop in range(s.max_active_set_loops if blocks else 1):
+        if loop > 0:
+            freeze_sets(blocks, att.u, seen)
+        left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
+        dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
+                                                min(s.max_iterations, left))
+        if not ok:
+            return _unfrozen(att, blocks)
+        if not any(b.set_changed(att.u) for b in blocks):
+            att.converged = True
+            return _unfrozen(att, blocks)
+    att.converged = False
+    att.message = "cohesive loading set still changing after the allowed active-set loops"
+    return _unfrozen(att, blocks)
+
+
+def _unfrozen(att: Attempt, blocks: list) -> Attempt:
+    for b in blocks:
+        b.unfreeze()
+    return att
+
+
+def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
+                            dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
+                            max_iterations: int) -> tuple[np.ndarray, float, bool]:
+    """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
+    updates ``att`` (state, iterations, residuals, message); returns the increment and whether
+    it converged."""
+    op, asm = problem.op, problem.assembler
+    q = op.reduce(problem.F_scaled)
+    qq = float(q @ q)
+    nq = math.sqrt(qq)
+    Fc_r = op.reduce(problem.F_const)
+    solver = problem.linear_solver(s.backend)
+    start = att.iterations
+    for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
         f, _ = asm.evaluate(u, tangent=False)  # the tangent only where an iteration follows
         r = op.reduce(problem.external(lam) - f)
         rn = float(np.linalg.norm(r))
         att.residuals.append(rn)
-        att.u, att.lam, att.iterations = u, lam, it
+        att.u, att.lam, att.iterations = u, lam, start + it
         if not np.isfinite(rn):
             att.message = "residual is not finite"
-            return att
+            return dur, dlam, False
         scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
         if it > 0 and rn <= s.tol_residual * scale:
-            if not any(b.set_changed(u) for b in cohesive):
-                att.converged = True
-                return att
-            loops += 1
-            if loops >= s.max_active_set_loops:
-                att.message = "cohesive loading set still changing after the allowed active-set loops"
-                return att
-            for b in cohesive:  # the actual sets at u, and iterate on under the same constraint
-                b.freeze(u)
-            it0 = it
-            f, _ = asm.evaluate(u, tangent=False)
-            r = op.reduce(problem.external(lam) - f)
-        if it == it_max or it - it0 >= s.max_iterations:
+            return dur, dlam, True
+        if it == max_iterations:
             break
         try:
             _, Kr = asm.evaluate_reduced(u, op)
             ab = solver.solve(Kr, np.column_stack([r, q]))
         except linear.SingularSystemError as exc:
             att.message = f"singular tangent ({exc})"
-            return att
+            return dur, dlam, False
         a, b = ab[:, 0], ab[:, 1]
         if mode == "arc":
             # ‖dur + a + δλ b‖² + ψ²(Δλ + δλ)² qq = Δl²  (Crisfield 1981)
@@ -251,12 +262,12 @@ def _arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mod
             dg = 0.5 * (lam0 * Fb - Fu0)
             if dg == 0.0:
                 att.message = "the dissipation constraint does not depend on λ here"
-                return att
+                return dur, dlam, False
             dl = -g / dg
         dur = dur + a + dl * b
         dlam += dl
-    att.message = f"no convergence in {att.iterations} iterations (last residual {att.residuals[-1]:.3e})"
-    return att
+    att.message = f"no convergence in {max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
+    return dur, dlam, False
 
 
 def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, area_prev: float | None,

@@ -119,9 +119,9 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     # then stalls on the way through a softening point (the DCB's crack tip, issue 13); full steps
     # converge there (contact blocks keep it: it helps at the stick/slip transitions)
     s_frozen = replace(s, line_search=False) if cohesive_only else s
+    seen: set[bytes] | None = set() if cohesive_only else None
     for _ in range(s.max_active_set_loops):
-        for b in blocks:
-            b.freeze(u)
+        freeze_sets(blocks, u, seen)
         left = s.max_contact_iterations - total.iterations
         if left <= 0:
             total.message = _contact_cap_message(total.iterations)
@@ -146,6 +146,22 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     for b in blocks:
         b.unfreeze()
     return u, total
+
+
+def freeze_sets(blocks: list, u: np.ndarray, seen: set[bytes] | None) -> None:
+    """Freeze the active sets of ``blocks`` at ``u`` for the next iterations of an active-set
+    loop. Cohesive blocks (``seen``: the loading sets frozen so far in this loop): where the sets
+    they would take now were frozen before - the loop cycles - only the most violated points
+    change (:meth:`~layershell.cohesive.CohesiveBlock.freeze` with ``limited``)."""
+    if seen is None:
+        for b in blocks:
+            b.freeze(u)
+        return
+    key = b"".join(np.packbits(b.actual_sets(u)[1]).tobytes() for b in blocks)
+    limited = key in seen
+    for b in blocks:
+        b.freeze(u, limited=limited)
+    seen.add(b"".join(np.packbits(b.frozen[1]).tobytes() for b in blocks))
 
 
 def _contact_cap_message(iterations: int) -> str:
