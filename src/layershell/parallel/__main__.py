@@ -1,8 +1,10 @@
 """``mpiexec -n N python -m layershell.parallel MODEL.toml [--mode linear|newton] [--out r.npz]``.
 
-Solves a bonded model distributed over N ranks and writes (rank 0) an ``.npz`` with the reduced
-solution ``x_red`` (linear mode) or the final full displacement ``u_full`` (newton mode), and the
-phase timings (maximum over the ranks). Prints one JSON line with the timings.
+Solves a bonded model, or one with cohesive interfaces, distributed over N ranks and writes (rank 0)
+an ``.npz`` with the reduced solution ``x_red`` (linear mode) or the final full displacement
+``u_full`` (newton mode; with cohesive interfaces also every step's ``u_steps`` and committed
+``damage_steps``), and the phase timings (maximum over the ranks). Prints one JSON line with the
+timings.
 """
 from __future__ import annotations
 
@@ -60,9 +62,20 @@ def main(argv: list[str] | None = None) -> int:
                 x = pb.solve_linear(args.lam)
             arrays = {"x_red": x, "u_full": pb.op.expand(x)}
         else:
-            steps = pb.load_steps(spec.load_factors, spec.newton)
+            if spec.path_following is not None:
+                if pb.rank == 0:
+                    print("error: distributed runs take the [steps] load factors with fixed steps: remove "
+                          "'steps.control' = 'arc_length' / 'steps.adaptive' (path following is serial, "
+                          "`layershell run`)", file=sys.stderr)
+                return 2
+            steps, damage = [], []
+            for st in pb.steps(spec.load_factors, spec.newton):
+                steps.append(st)
+                damage.append(pb.damage())
             arrays = {"u_full": steps[-1][1], "load_factors": np.array([s[0] for s in steps]),
                       "iterations": np.array([s[2] for s in steps])}
+            if pb.interfaces is not None:  # every step's displacement and committed damage
+                arrays.update(u_steps=np.array([s[1] for s in steps]), damage_steps=np.array(damage))
     except (ConvergenceError, SolveError) as exc:  # collective: every rank stops here
         if pb.rank == 0:
             print(f"error: {exc}", file=sys.stderr)
