@@ -53,6 +53,14 @@ def element_ranges(weights: np.ndarray, size: int) -> np.ndarray:
     return b
 
 
+def interface_rows(block, lo: int, hi: int) -> np.ndarray:
+    """The element rows of an interface block (cohesive) that the rank owning mesh elements
+    ``lo:hi`` assembles: those on its elements (``block.itf.elements``), so each row goes to
+    exactly one rank."""
+    el = block.itf.elements
+    return np.flatnonzero((el >= lo) & (el < hi))
+
+
 def local_blocks(model: Model, dm: DofMap, elements: np.ndarray) -> list[Block]:
     """The layer blocks of :func:`layershell.assembly.build_blocks` restricted to ``elements``
     (only this rank's reference data is computed)."""

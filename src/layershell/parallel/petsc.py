@@ -28,7 +28,7 @@ from ..solver import linear
 from ..solver.newton import ConvergenceError, DebondCut, NewtonResult, NewtonSettings
 from ..solver.newton import load_steps as serial_load_steps
 from ..solver.problem import Problem
-from .partition import LocalAssembly, element_ranges, element_weights
+from .partition import LocalAssembly, element_ranges, element_weights, interface_rows
 
 SOLVERS = ("mumps", "gamg")
 
@@ -154,7 +154,7 @@ class DistributedProblem:
         self.elements = np.arange(self.bounds[self.rank], self.bounds[self.rank + 1])
         # an interface block's element rows go to the rank that owns the mesh element below them
         lo_e, hi_e = self.bounds[self.rank], self.bounds[self.rank + 1]
-        extra = [(b, np.flatnonzero((b.itf.elements >= lo_e) & (b.itf.elements < hi_e))) for b in self.extra_blocks]
+        extra = [(b, interface_rows(b, lo_e, hi_e)) for b in self.extra_blocks]
         self.local = LocalAssembly(model, dm, self.op, self.elements, extra=extra)
         self.assembler = _Assembler(self)
         n = self.op.n_red
