@@ -103,6 +103,17 @@ def plate_spec(**kw):
 SMALL_DCB = {"nx = 150": "nx = 25", "lx = 150.0": "lx = 100.0", "near(x, 150)": "near(x, 100)",
              "x < 54.999": "x < 39.999", "sigma_max = 30.0": "sigma_max = 10.0"}
 
+# the DCB example opened by prescribed displacements of its loaded ends (λ × 5 mm per arm, the
+# loads switched off), as in tests/test_dcb.py: equilibrium through the peak into propagation
+DISPLACEMENT_CONTROL = {
+    '[[loads]]                 # upper arm pulled up':
+        '[[supports]]\ntype = "fix"\nwhere = "near(x, 0)"\nlayer = "upper"\ncomponents = ["z"]\nvalue = [5.0]\n\n'
+        '[[supports]]\ntype = "fix"\nwhere = "near(x, 0)"\nlayer = "lower"\ncomponents = ["z"]\nvalue = [-5.0]\n\n'
+        '[[loads]]                 # upper arm pulled up',
+    'distribution = "where(t > 1.98, 2.5252525, 0.0)"': "distribution = 0.0",
+    'distribution = "where(t < 1.98, 2.5252525, 0.0)"': "distribution = 0.0",
+}
+
 
 def dcb_text(factors: list[float], edits: dict | None = None) -> str:
     """examples/dcb_cohesive.toml with ``edits`` and the [steps] factors replaced."""
@@ -386,17 +397,22 @@ def test_mpi_cohesive_equals_serial(mpi_python, tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", ["dcb_example", "bisection"])
+@pytest.mark.parametrize("case", ["dcb_example", "dcb_propagation", "bisection"])
 def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     """mpiexec -n 2. ``dcb_example``: examples/dcb_cohesive.toml (150 elements) under its force
     control up to λ = 0.62, the last of its steps before the peak (λ ≈ 0.624, where force
     control stops): 13 steps, damage growth from λ = 0.3 on, up to 9 iterations per step.
+    ``dcb_propagation``: the same DCB under displacement control through the peak into crack
+    growth (the fully damaged points 492 → 509; up to 24 iterations per step).
     ``bisection``: the short DCB with a step across the onset that is bisected twice (56
     iterations). Every step's displacement and damage equal the serial run to 1e-8 (measured:
     DCB example 1.3e-9 (in the first, linear steps: the direct solvers' round-off on this
-    ill-conditioned system - MUMPS here, PARDISO serially) / 4.5e-12; bisection 1e-11 / 4e-15)."""
+    ill-conditioned system - MUMPS here, PARDISO serially) / 4.5e-12; propagation 6e-11 /
+    7e-15 (on steps of 0.05 to λ = 0.6: 492 → 563 fully damaged points); bisection 1e-11 / 4e-15)."""
     if case == "dcb_example":
         text = dcb_text([0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.55, 0.58, 0.6, 0.61, 0.62])
+    elif case == "dcb_propagation":
+        text = dcb_text([0.1, 0.2, 0.3, 0.4, 0.45, 0.5], DISPLACEMENT_CONTROL)
     else:
         text = dcb_text([0.2, 0.3, 0.4, 0.6, 0.8], SMALL_DCB)
     (tmp_path / "dcb.toml").write_text(text)
@@ -404,6 +420,8 @@ def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     ref = serial_cohesive_steps(text)
     growth = [np.max(b[2] - a[2]) for a, b in zip(ref, ref[1:])]
     assert sum(g > 1e-3 for g in growth) >= 3  # several steps with damage growth
+    if case == "dcb_propagation":  # the crack has grown: more fully damaged points
+        assert np.sum(ref[-1][2] >= 1 - 1e-9) > np.sum(ref[0][2] >= 1 - 1e-9) + 10
     diff = _compare_cohesive(ref, np.load(tmp_path / "c.npz"))
     assert diff["du"] <= 1e-8 and diff["dd"] <= 1e-8, diff
 
