@@ -20,7 +20,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(prog="python -m layershell.parallel", description=__doc__.splitlines()[0])
     ap.add_argument("model", help="model file (TOML)")
     ap.add_argument("--mode", choices=("linear", "newton"), default="linear",
-                    help="linear: one solve K_r x = Tᵀ(λF) at u = 0; newton: the [steps] load factors")
+                    help="linear: one solve K_r x = Tᵀ(λF) at u = 0; newton: the [steps] (load factors, or "
+                         "arc length / adaptive steps)")
     ap.add_argument("--lam", type=float, default=1.0, help="load factor of the linear solve (default 1)")
     ap.add_argument("--solver", choices=("mumps", "gamg"), default="mumps")
     ap.add_argument("--repeat", type=int, default=1, help="linear mode: assemble and solve this often (timing)")
@@ -42,6 +43,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {unavailable_message(exc)}", file=sys.stderr)
         return 2
     from ..io.build import InputError, load
+    from ..solver.arclength import PathError
     from ..solver.newton import ConvergenceError
     from .petsc import DistributedProblem, SolveError, UnsupportedModelError
 
@@ -62,24 +64,22 @@ def main(argv: list[str] | None = None) -> int:
                 x = pb.solve_linear(args.lam)
             arrays = {"x_red": x, "u_full": pb.op.expand(x)}
         else:
-            if spec.path_following is not None:
-                if pb.rank == 0:
-                    print("error: distributed runs take the [steps] load factors with fixed steps: remove "
-                          "'steps.control' = 'arc_length' / 'steps.adaptive' (path following is serial, "
-                          "`layershell run`)", file=sys.stderr)
-                return 2
             steps, damage = [], []
-            for st in pb.steps(spec.load_factors, spec.newton):
+            for st in pb.steps(spec.load_factors, spec.newton, spec.path_following):
                 steps.append(st)
                 damage.append(pb.damage())
             arrays = {"u_full": steps[-1][1], "load_factors": np.array([s[0] for s in steps]),
                       "iterations": np.array([s[2] for s in steps])}
-            if pb.interfaces is not None:  # every step's displacement and committed damage
+            if pb.interfaces is not None or spec.path_following is not None:  # every step's u and damage
                 arrays.update(u_steps=np.array([s[1] for s in steps]), damage_steps=np.array(damage))
     except (ConvergenceError, SolveError) as exc:  # collective: every rank stops here
         if pb.rank == 0:
             print(f"error: {exc}", file=sys.stderr)
         return 1
+    except (PathError, UnsupportedModelError) as exc:  # bad [steps] settings for this model
+        if pb.rank == 0:
+            print(f"error: {exc}", file=sys.stderr)
+        return 2
     t = pb.finish_timings()
     total = pb._max(time.perf_counter() - t_start)
     out.update(setup_s=t.setup, assemble_s=t.assemble, solve_s=t.solve, gather_s=t.gather,

@@ -378,21 +378,33 @@ class DistributedProblem:
         res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
         return u, res
 
-    def steps(self, load_factors, s: NewtonSettings | None = None) -> Iterator[tuple[float, np.ndarray, int]]:
+    def steps(self, load_factors, s: NewtonSettings | None = None,
+              path=None) -> Iterator[tuple[float, np.ndarray, int]]:
         """Newton over the load factors, yielding ``(λ, u_full, iterations)`` per converged step.
-        Bonded models: :meth:`newton`, no bisection. Models with cohesive interfaces: the serial
-        :func:`layershell.solver.newton.load_steps` on this problem - the same active-set loop
-        (``newton``: frozen tension/loading sets, ``set_changed``), bisection, and the damage
-        commit ``InterfaceController.update`` after every converged step, as ``runner.run``
-        calls it; every rank runs it on the replicated state and takes the same decisions."""
+        Bonded models with fixed steps: :meth:`newton`, no bisection. Models with cohesive
+        interfaces: the serial :func:`layershell.solver.newton.load_steps` on this problem - the
+        same active-set loop (``newton``: frozen tension/loading sets, ``set_changed``),
+        bisection, and the damage commit ``InterfaceController.update`` after every converged
+        step, as ``runner.run`` calls them; every rank runs them on the replicated state and so
+        takes the same decisions. ``path`` (``spec.path_following``: arc length or adaptive
+        steps): the serial :func:`layershell.solver.arclength.path_steps` on this problem
+        (``load_factors`` unused)."""
         s = s or NewtonSettings()
-        if self.interfaces is not None:
+        if self.interfaces is not None or path is not None:
             ctl = self.interfaces
-            cut = None
-            if ctl.settings.max_debond_fraction is not None:
-                cut = DebondCut(ctl.settings.max_debond_fraction, ctl.settings.max_debond_cuts,
-                                lambda pb: pb.interfaces.debonded_fraction())
-            for st in serial_load_steps(self, load_factors, s, on_step_end=ctl.update, cut=cut):
+            on_end = ctl.update if ctl is not None else None
+            if path is not None:  # as runner._path_steps (without checkpoints and probe watch)
+                from ..solver.arclength import path_steps
+
+                measure = (lambda pb: pb.interfaces.debonded_fraction()) if ctl is not None else None
+                it = path_steps(self, s, path, on_step_end=on_end, measure=measure)
+            else:
+                cut = None
+                if ctl.settings.max_debond_fraction is not None:
+                    cut = DebondCut(ctl.settings.max_debond_fraction, ctl.settings.max_debond_cuts,
+                                    lambda pb: pb.interfaces.debonded_fraction())
+                it = serial_load_steps(self, load_factors, s, on_step_end=on_end, cut=cut)
+            for st in it:
                 yield st.load_factor, st.u, st.iterations
             return
         u = np.zeros(self.dm.n_full)
@@ -404,9 +416,9 @@ class DistributedProblem:
                                        "of bonded models", float(lam), res.residuals[-1])
             yield float(lam), u.copy(), res.iterations
 
-    def load_steps(self, load_factors, s: NewtonSettings | None = None) -> list[tuple[float, np.ndarray, int]]:
+    def load_steps(self, load_factors, s: NewtonSettings | None = None, path=None) -> list[tuple[float, np.ndarray, int]]:
         """:meth:`steps` as a list ``[(λ, u_full, iterations), ...]``."""
-        return list(self.steps(load_factors, s))
+        return list(self.steps(load_factors, s, path))
 
     def damage(self) -> np.ndarray:
         """The committed damage of every cohesive interface point, concatenated (empty without)."""
