@@ -443,6 +443,25 @@ def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     assert diff["du"] <= 1e-8 and diff["dd"] <= 1e-8, diff
 
 
+@pytest.mark.slow
+def test_mpi_bonded_adaptive_steps_equal_serial(mpi_python, tmp_path):
+    """A bonded model with [steps] adaptive = true: the driver runs the serial ``path_steps`` on
+    the distributed problem; the same steps, iterations and displacements as serially (measured
+    2e-15 relative)."""
+    from layershell.solver.arclength import path_steps
+
+    text = plate_text(nonlinear=True, load=5.0, nx=3, ny=2).replace("[steps]\nn = 2", "[steps]\nn = 2\nadaptive = true")
+    (tmp_path / "plate.toml").write_text(text)
+    _mpirun(mpi_python, 2, tmp_path / "plate.toml", tmp_path / "p.npz", "--mode", "newton")
+    spec = build(parse(text, "plate"))
+    ref = list(path_steps(Problem.build(spec.model), spec.newton, spec.path_following))
+    res = np.load(tmp_path / "p.npz")
+    assert np.allclose(res["load_factors"], [st.load_factor for st in ref], rtol=1e-12, atol=0)
+    assert res["iterations"].tolist() == [st.iterations for st in ref]
+    for k, st in enumerate(ref):
+        assert np.linalg.norm(res["u_steps"][k] - st.u) <= 1e-10 * np.linalg.norm(st.u)
+
+
 def test_mpi_bad_input_exits_2(mpi_python, tmp_path):
     bad = tmp_path / "bad.toml"
     bad.write_text(plate_text().replace('thickness = 3.0', 'thickness = "abc"'))

@@ -10,6 +10,12 @@ Tᵀ(λF - f_int) is a distributed PETSc vector. The default solver is KSP ``pre
 (direct, reproduces the serial solution to round-off); ``gamg`` gives CG + algebraic multigrid.
 The solution is gathered on every rank (``Scatter.toAll``) and expanded u = T u_r there.
 
+Cohesive interfaces (issue 13): the blocks and their damage state are replicated (the serial
+``InterfaceController``), each rank assembles the block rows on its elements (part of the exact
+preallocation), and :class:`DistributedProblem` offers the interface of
+:class:`layershell.solver.problem.Problem`, so that the serial ``load_steps``/``newton``
+(active-set loop, bisection, damage commit) and ``path_steps`` run on it unchanged.
+
 Run with ``mpiexec -n 2 python -m layershell.parallel MODEL.toml`` (docs/distributed.md).
 """
 from __future__ import annotations
@@ -116,7 +122,8 @@ class Timings:
 
 
 class DistributedProblem:
-    """The static problem of a bonded model distributed over the ranks of ``comm``."""
+    """The static problem of a bonded model, or one with cohesive interfaces, distributed over the
+    ranks of ``comm``."""
 
     def __init__(self, model: Model, solver: str = "mumps", comm=None):
         check_supported(model)
