@@ -405,6 +405,20 @@ def test_mpi_cohesive_equals_serial(mpi_python, tmp_path):
 
 
 @pytest.mark.slow
+def test_mpi_stopped_run_keeps_its_converged_steps(mpi_python, tmp_path):
+    """A run whose Newton stops (here: a step far past the short DCB's peak, no bisection, at most
+    3 iterations) exits with code 1 and the serial message, and still writes the converged steps."""
+    text = dcb_text([0.28, 0.35, 0.95], SMALL_DCB).replace("max_bisections = 6", "max_bisections = 0\nmax_iterations = 3")
+    (tmp_path / "dcb.toml").write_text(text)
+    cmd = ["mpiexec", "-n", "2", mpi_python, "-m", "layershell.parallel", str(tmp_path / "dcb.toml"), "--mode", "newton",
+           "--out", str(tmp_path / "s.npz")]
+    p = subprocess.run(cmd, env=_mpi_env(), capture_output=True, text=True, timeout=240, cwd=ROOT)
+    assert p.returncode == 1 and "no convergence towards load factor 0.95" in p.stderr, p.stderr
+    res = np.load(tmp_path / "s.npz")
+    assert res["load_factors"].tolist() == [0.28, 0.35] and res["damage_steps"].shape[0] == 2
+    assert "no convergence" in json.loads(str(res["info"]))["stopped"]
+
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["dcb_example", "dcb_propagation", "bisection", "adaptive", "arc_length"])
 def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     """mpiexec -n 2. ``dcb_example``: examples/dcb_cohesive.toml (150 elements) under its force

@@ -58,24 +58,37 @@ def main(argv: list[str] | None = None) -> int:
     out: dict = {"ranks": pb.size, "n_red": pb.op.n_red, "n_full": pb.dm.n_full, "nnz": pb.nnz,
                  "n_elements": int(spec.model.mesh.elements.shape[0]),
                  "elements_per_rank": np.diff(pb.bounds).tolist()}
+    steps: list = []
+    damage: list = []
+    rc = 0
+
+    def step_arrays() -> dict:
+        if not steps:
+            return {}
+        arrays = {"u_full": steps[-1][1], "load_factors": np.array([s[0] for s in steps]),
+                  "iterations": np.array([s[2] for s in steps])}
+        if pb.interfaces is not None or spec.path_following is not None:  # every step's u and damage
+            arrays.update(u_steps=np.array([s[1] for s in steps]), damage_steps=np.array(damage))
+        return arrays
+
     try:
         if args.mode == "linear":
             for _ in range(args.repeat):
                 x = pb.solve_linear(args.lam)
             arrays = {"x_red": x, "u_full": pb.op.expand(x)}
         else:
-            steps, damage = [], []
             for st in pb.steps(spec.load_factors, spec.newton, spec.path_following):
                 steps.append(st)
                 damage.append(pb.damage())
-            arrays = {"u_full": steps[-1][1], "load_factors": np.array([s[0] for s in steps]),
-                      "iterations": np.array([s[2] for s in steps])}
-            if pb.interfaces is not None or spec.path_following is not None:  # every step's u and damage
-                arrays.update(u_steps=np.array([s[1] for s in steps]), damage_steps=np.array(damage))
+            arrays = step_arrays()
     except (ConvergenceError, SolveError) as exc:  # collective: every rank stops here
         if pb.rank == 0:
             print(f"error: {exc}", file=sys.stderr)
-        return 1
+        if not steps:
+            return 1
+        # the converged steps so far are written (a force-controlled run that stops at its peak)
+        arrays, rc = step_arrays(), 1
+        out["stopped"] = str(exc)
     except (PathError, UnsupportedModelError) as exc:  # bad [steps] settings for this model
         if pb.rank == 0:
             print(f"error: {exc}", file=sys.stderr)
@@ -90,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         if args.out:
             np.savez(args.out, **arrays, info=json.dumps(out))
     pb.destroy()
-    return 0
+    return rc
 
 
 if __name__ == "__main__":
