@@ -4,6 +4,6 @@
 reduced system. :mod:`.petsc`: the PETSc matrix/vector/KSP side (imports petsc4py lazily).
 Command line: ``mpiexec -n 2 python -m layershell.parallel MODEL.toml --out result.npz``.
 """
-from .partition import LocalAssembly, element_ranges, element_weights, local_blocks
+from .partition import LocalAssembly, element_ranges, element_weights, interface_rows, local_blocks
 
-__all__ = ["LocalAssembly", "element_ranges", "element_weights", "local_blocks"]
+__all__ = ["LocalAssembly", "element_ranges", "element_weights", "interface_rows", "local_blocks"]

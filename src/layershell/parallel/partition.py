@@ -53,6 +53,14 @@ def element_ranges(weights: np.ndarray, size: int) -> np.ndarray:
     return b
 
 
+def interface_rows(block, lo: int, hi: int) -> np.ndarray:
+    """The element rows of an interface block (cohesive) that the rank owning mesh elements
+    ``lo:hi`` assembles: those on its elements (``block.itf.elements``), so each row goes to
+    exactly one rank."""
+    el = block.itf.elements
+    return np.flatnonzero((el >= lo) & (el < hi))
+
+
 def local_blocks(model: Model, dm: DofMap, elements: np.ndarray) -> list[Block]:
     """The layer blocks of :func:`layershell.assembly.build_blocks` restricted to ``elements``
     (only this rank's reference data is computed)."""
@@ -74,16 +82,20 @@ class LocalAssembly:
     contributions to the *reduced* system: f_r part on ``red_dofs`` and K_r data on ``pattern``."""
 
     def __init__(self, model: Model, dm: DofMap, op: ConstraintOperator, elements: np.ndarray,
-                 chunk: int = 256):
+                 chunk: int = 256, extra: list | None = None):
         self.model, self.dm, self.op, self.chunk = model, dm, op, chunk
         self.elements = np.asarray(elements, np.int64)
         self.blocks = local_blocks(model, dm, self.elements)
-        dofs = [b.dofs.ravel() for b in self.blocks]
+        # element-like interface blocks (cohesive, issue 13): ``(block, rows)`` - the block's
+        # element rows this rank inserts (its fixed pattern is part of the preallocation)
+        self.extra = [(b, np.asarray(rows, np.int64)) for b, rows in (extra or [])]
+        dofs = [b.dofs.ravel() for b in self.blocks] + [b.dofs[rows].ravel() for b, rows in self.extra]
         # local full DOFs (compact numbering) and the scatter map into the local full CSR pattern
         # (the construction of Assembler._pattern on this rank's elements only)
         self.full_dofs = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)
         nl = self.full_dofs.size
-        self._fidx = [np.searchsorted(self.full_dofs, b.dofs) for b in self.blocks]
+        self._fidx = ([np.searchsorted(self.full_dofs, b.dofs) for b in self.blocks]
+                      + [np.searchsorted(self.full_dofs, b.dofs[rows]) for b, rows in self.extra])
         keys = [(d[:, :, None] * nl + d[:, None, :]).ravel() for d in self._fidx]
         key = np.concatenate(keys) if keys else np.zeros(0, np.int64)
         ukey, scatter = np.unique(key, return_inverse=True)
@@ -105,6 +117,14 @@ class LocalAssembly:
     def evaluate(self, u_full: np.ndarray, tangent: bool = True):
         """``(f_r, K_r_data)``: this rank's Tᵀ f_int on ``red_dofs`` and its K_r entries on
         ``pattern`` (None when ``tangent`` is False). Same kernel as the serial assembler."""
+        f_loc, data = self.evaluate_local(u_full, tangent)
+        return self._Rt @ f_loc, data
+
+    def evaluate_local(self, u_full: np.ndarray, tangent: bool = True):
+        """``(f_loc, K_r_data)``: this rank's internal force on the full DOFs ``full_dofs`` and
+        its K_r entries on ``pattern`` (None when ``tangent`` is False). The layer blocks by the
+        serial kernel; an extra block by its ``response`` (as in ``Assembler._values``), of which
+        this rank takes its rows."""
         nl = self.full_dofs.size
         fval, vals = [], []
         for b in self.blocks:
@@ -115,15 +135,35 @@ class LocalAssembly:
                 fval.append(fe.ravel())
                 if tangent:
                     vals.append(Ke.ravel())
+        for b, rows in self.extra:
+            fe, Ke = extra_response(b, u_full, tangent)
+            fval.append(fe[rows].ravel())
+            if tangent:
+                vals.append(Ke[rows].ravel())
         f_loc = np.bincount(self._fidx, weights=np.concatenate(fval) if fval else None, minlength=nl)
-        f_r = self._Rt @ f_loc
         if not tangent:
-            return f_r, None
+            return f_loc, None
         data = np.bincount(self.scatter, weights=np.concatenate(vals) if vals else None,
                            minlength=self.nnz_full)
-        return f_r, self.pattern.G @ data
+        return f_loc, self.pattern.G @ data
 
     def reduced_matrix(self, data: np.ndarray) -> sp.csr_matrix:
         """This rank's K_r part as a SciPy matrix (n_red × n_red) - for checks."""
         n = self.op.n_red
         return sp.csr_matrix((data, (self.pattern.rows, self.pattern.cols)), shape=(n, n))
+
+
+def extra_response(block, u_full: np.ndarray, tangent: bool):
+    """``(f (e, m), K (e, m, m) or None)`` of an element-like block, with a compact tangent
+    (``(values, elements)``, only the elements with stiffness) expanded as in
+    ``Assembler._values``."""
+    if getattr(block, "compact_tangent", False):
+        fe, Ke = block.response(u_full, tangent, compact=True)
+    else:
+        fe, Ke = block.response(u_full, tangent)
+    if tangent and isinstance(Ke, tuple):
+        vals, el = Ke
+        full = np.zeros((block.dofs.shape[0], *vals.shape[1:]))
+        full[el] = vals
+        Ke = full
+    return fe, Ke

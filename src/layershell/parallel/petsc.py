@@ -10,12 +10,19 @@ Tᵀ(λF - f_int) is a distributed PETSc vector. The default solver is KSP ``pre
 (direct, reproduces the serial solution to round-off); ``gamg`` gives CG + algebraic multigrid.
 The solution is gathered on every rank (``Scatter.toAll``) and expanded u = T u_r there.
 
+Cohesive interfaces (issue 13): the blocks and their damage state are replicated (the serial
+``InterfaceController``), each rank assembles the block rows on its elements (part of the exact
+preallocation), and :class:`DistributedProblem` offers the interface of
+:class:`layershell.solver.problem.Problem`, so that the serial ``load_steps``/``newton``
+(active-set loop, bisection, damage commit) and ``path_steps`` run on it unchanged.
+
 Run with ``mpiexec -n 2 python -m layershell.parallel MODEL.toml`` (docs/distributed.md).
 """
 from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import Iterator
 
 import numpy as np
 
@@ -23,8 +30,11 @@ from ..constraints import constraint_operator
 from ..dofs import number_dofs
 from ..loads import external_forces
 from ..model import Model
-from ..solver.newton import ConvergenceError, NewtonResult, NewtonSettings
-from .partition import LocalAssembly, element_ranges, element_weights
+from ..solver import linear
+from ..solver.newton import ConvergenceError, DebondCut, NewtonResult, NewtonSettings
+from ..solver.newton import load_steps as serial_load_steps
+from ..solver.problem import Problem
+from .partition import LocalAssembly, element_ranges, element_weights, interface_rows
 
 SOLVERS = ("mumps", "gamg")
 
@@ -74,12 +84,19 @@ class UnsupportedModelError(ValueError):
 
 
 def check_supported(model: Model) -> None:
-    """Raise :class:`UnsupportedModelError` for models the distributed solve cannot handle."""
-    if model.interface_laws:
+    """Raise :class:`UnsupportedModelError` for models the distributed solve cannot handle:
+    interfaces other than ``law = "cohesive"`` (the thesis's stress criterion releases bonds and
+    so changes the constraint operator and the sparsity pattern; contact-only interfaces)."""
+    from ..cohesive import CohesiveLaw
+
+    other = sorted(model.layers[k].name for k, law in model.interface_laws.items() if not isinstance(law, CohesiveLaw))
+    if other:
+        names = ", ".join(f"'{n}'" for n in other)
         raise UnsupportedModelError(
-            "distributed runs support bonded models only: remove the [[interfaces]] sections or run "
-            "serially with `layershell run` (delamination, contact and friction are not distributed "
-            "yet, see docs/distributed.md)")
+            f"distributed runs support bonded models and cohesive interfaces only: the [[interfaces]] "
+            f"section(s) of layer {names} use another law (the thesis's stress criterion releases "
+            "bonds and changes the sparsity pattern, which is not distributed yet). Set law = \"cohesive\" "
+            "there (with G_Ic, G_IIc), or run serially with `layershell run` (see docs/distributed.md)")
 
 
 def row_ranges(n: int, size: int) -> np.ndarray:
@@ -105,7 +122,8 @@ class Timings:
 
 
 class DistributedProblem:
-    """The static problem of a bonded model distributed over the ranks of ``comm``."""
+    """The static problem of a bonded model, or one with cohesive interfaces, distributed over the
+    ranks of ``comm``."""
 
     def __init__(self, model: Model, solver: str = "mumps", comm=None):
         check_supported(model)
@@ -120,15 +138,32 @@ class DistributedProblem:
         self.model = model
         self.dm = dm = number_dofs(model)
         below = model.below()
-        bonded = {up: dm.present[up] & dm.present[lo] for up, lo in below.items()}
-        self.op = constraint_operator(model, dm, bonded)
+        self.bonded = {up: dm.present[up] & dm.present[lo] for up, lo in below.items()}
         self.F_scaled, self.F_const = external_forces(model, dm)
+        # cohesive interfaces (issue 13): the serial InterfaceController, replicated on every rank
+        # (same blocks, same damage state; the block is small next to the shell elements); it
+        # unbonds the cohesive interfaces before T is built
+        self.extra_blocks: list = []
+        self.F_friction = None
+        self.interfaces = None
+        self.monitor = None
+        if model.interface_laws:
+            from ..solver.interface_state import InterfaceController
+
+            self.interfaces = InterfaceController.build(self, model.interface_laws, model.initially_debonded,
+                                                        model.initial_laws, model.delamination)
+        self._bonded_built = {k: v.copy() for k, v in self.bonded.items()}
+        self.op = constraint_operator(model, dm, self.bonded)
         if model.mesh.elements.shape[0] < self.size:
             raise UnsupportedModelError(f"{self.size} MPI ranks for {model.mesh.elements.shape[0]} elements: "
                                         "start at most one rank per element (mpiexec -n)")
         self.bounds = element_ranges(element_weights(model), self.size)
         self.elements = np.arange(self.bounds[self.rank], self.bounds[self.rank + 1])
-        self.local = LocalAssembly(model, dm, self.op, self.elements)
+        # an interface block's element rows go to the rank that owns the mesh element below them
+        lo_e, hi_e = self.bounds[self.rank], self.bounds[self.rank + 1]
+        extra = [(b, interface_rows(b, lo_e, hi_e)) for b in self.extra_blocks]
+        self.local = LocalAssembly(model, dm, self.op, self.elements, extra=extra)
+        self.assembler = _Assembler(self)
         n = self.op.n_red
         self.rows = row_ranges(n, self.size)
         self.lo, self.hi = int(self.rows[self.rank]), int(self.rows[self.rank + 1])
@@ -220,15 +255,7 @@ class DistributedProblem:
         b.setValues(self._own, self.reduced_external(lam)[self.lo:self.hi], addv=PETSc.InsertMode.ADD_VALUES)
         b.assemblyBegin()
         if tangent:
-            A = self.A
-            A.zeroEntries()
-            A.setValuesIJV(self._csr_ptr, self._csr_cols, data, addv=PETSc.InsertMode.ADD_VALUES,
-                           rowmap=self._csr_rows)
-            A.assemblyBegin()
-            A.assemblyEnd()
-            if not self._assembled:  # later assemblies send to the same ranks: cheaper exchange
-                A.setOption(PETSc.Mat.Option.SUBSET_OFF_PROC_ENTRIES, True)
-                self._assembled = True
+            self._insert(data)
         b.assemblyEnd()
         self.timings.assemble += time.perf_counter() - t0
         self.timings.assemble_cpu += time.process_time() - c0
@@ -258,6 +285,62 @@ class DistributedProblem:
 
     def residual_norm(self) -> float:
         return float(self.b.norm())
+
+    # --- the interface of solver.problem.Problem (serial Newton/active-set loop on this problem)
+    impose = Problem.impose
+    external = Problem.external
+    reactions = Problem.reactions
+    snapshot = Problem.snapshot
+    restore = Problem.restore
+    prescribed = Problem.prescribed
+
+    def rebuild_constraints(self) -> None:
+        """T stays: cohesive interfaces never change the bond state (a thesis-law release would
+        change T and the preallocated pattern, and is refused by :func:`check_supported`)."""
+        if any(not np.array_equal(v, self._bonded_built[k]) for k, v in self.bonded.items()):
+            raise UnsupportedModelError("the bond state changed during a distributed run; bond releases "
+                                        "(thesis-law interfaces) are not distributed yet")
+
+    def linear_solver(self, backend: str = "auto") -> "_Solver":
+        """The PETSc KSP as :class:`layershell.solver.linear.LinearSolver` (``backend`` is ignored:
+        the KSP set up from ``solver`` and the ``-ls_`` options)."""
+        return _Solver(self)
+
+    def internal_force(self, u_full: np.ndarray, tangent: bool) -> np.ndarray:
+        """The full-space internal force f_int(u) on every rank (the ranks' parts summed on rank
+        0 and broadcast, so that every rank takes the same decisions from it); with ``tangent``
+        also A = Tᵀ K(u) T assembled."""
+        t0, c0 = time.perf_counter(), time.process_time()
+        f_loc, data = self.local.evaluate_local(u_full, tangent)
+        part = np.zeros(self.dm.n_full)
+        part[self.local.full_dofs] = f_loc
+        f = np.empty_like(part)
+        self.mpi.Reduce(part, f, op=self.MPI.SUM, root=0)
+        self.mpi.Bcast(f, root=0)
+        if tangent:
+            self._insert(data)
+        self.timings.assemble += time.perf_counter() - t0
+        self.timings.assemble_cpu += time.process_time() - c0
+        self.timings.evaluations += 1
+        return f
+
+    def _insert(self, data: np.ndarray) -> None:
+        """A = the ranks' K_r entries ``data`` on their patterns (ADD_VALUES)."""
+        PETSc = self.PETSc
+        A = self.A
+        A.zeroEntries()
+        A.setValuesIJV(self._csr_ptr, self._csr_cols, data, addv=PETSc.InsertMode.ADD_VALUES,
+                       rowmap=self._csr_rows)
+        A.assemblyBegin()
+        A.assemblyEnd()
+        if not self._assembled:  # later assemblies send to the same ranks: cheaper exchange
+            A.setOption(PETSc.Mat.Option.SUBSET_OFF_PROC_ENTRIES, True)
+            self._assembled = True
+
+    def solve_replicated(self, r: np.ndarray) -> np.ndarray:
+        """Solve A x = r for a replicated reduced right-hand side (every rank sets its rows)."""
+        self.b.setArray(np.ascontiguousarray(r[self.lo:self.hi]))
+        return self.solve()
 
     # --- solves ------------------------------------------------------------------------------
     def solve_linear(self, lam: float = 1.0, u_full: np.ndarray | None = None) -> np.ndarray:
@@ -302,19 +385,54 @@ class DistributedProblem:
         res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
         return u, res
 
-    def load_steps(self, load_factors, s: NewtonSettings | None = None) -> list[tuple[float, np.ndarray, int]]:
-        """Newton over the load factors (no bisection yet); ``[(λ, u_full, iterations), ...]``."""
+    def steps(self, load_factors, s: NewtonSettings | None = None,
+              path=None) -> Iterator[tuple[float, np.ndarray, int]]:
+        """Newton over the load factors, yielding ``(λ, u_full, iterations)`` per converged step.
+        Bonded models with fixed steps: :meth:`newton`, no bisection. Models with cohesive
+        interfaces: the serial :func:`layershell.solver.newton.load_steps` on this problem - the
+        same active-set loop (``newton``: frozen tension/loading sets, ``set_changed``),
+        bisection, and the damage commit ``InterfaceController.update`` after every converged
+        step, as ``runner.run`` calls them; every rank runs them on the replicated state and so
+        takes the same decisions. ``path`` (``spec.path_following``: arc length or adaptive
+        steps): the serial :func:`layershell.solver.arclength.path_steps` on this problem
+        (``load_factors`` unused)."""
         s = s or NewtonSettings()
+        if self.interfaces is not None or path is not None:
+            ctl = self.interfaces
+            on_end = ctl.update if ctl is not None else None
+            if path is not None:  # as runner._path_steps (without checkpoints and probe watch)
+                from ..solver.arclength import path_steps
+
+                measure = (lambda pb: pb.interfaces.debonded_fraction()) if ctl is not None else None
+                it = path_steps(self, s, path, on_step_end=on_end, measure=measure)
+            else:
+                cut = None
+                if ctl.settings.max_debond_fraction is not None:
+                    cut = DebondCut(ctl.settings.max_debond_fraction, ctl.settings.max_debond_cuts,
+                                    lambda pb: pb.interfaces.debonded_fraction())
+                it = serial_load_steps(self, load_factors, s, on_step_end=on_end, cut=cut)
+            for st in it:
+                yield st.load_factor, st.u, st.iterations
+            return
         u = np.zeros(self.dm.n_full)
-        out = []
         for lam in load_factors:
             u, res = self.newton(u, float(lam), s)
             if not res.converged:
                 raise ConvergenceError(f"distributed Newton: no convergence at load factor {lam:.6g} "
-                                       f"({res.message}); bisection is not implemented for MPI runs",
-                                       float(lam), res.residuals[-1])
-            out.append((float(lam), u.copy(), res.iterations))
-        return out
+                                       f"({res.message}); bisection is not implemented for MPI runs "
+                                       "of bonded models", float(lam), res.residuals[-1])
+            yield float(lam), u.copy(), res.iterations
+
+    def load_steps(self, load_factors, s: NewtonSettings | None = None, path=None) -> list[tuple[float, np.ndarray, int]]:
+        """:meth:`steps` as a list ``[(λ, u_full, iterations), ...]``."""
+        return list(self.steps(load_factors, s, path))
+
+    def damage(self) -> np.ndarray:
+        """The committed damage of every cohesive interface point, concatenated (empty without)."""
+        from ..cohesive import CohesiveBlock
+
+        d = [b.d_old.ravel() for b in self.extra_blocks if isinstance(b, CohesiveBlock)]
+        return np.concatenate(d) if d else np.zeros(0)
 
     def finish_timings(self) -> Timings:
         """Timings with every phase reduced to its maximum over the ranks."""
@@ -325,3 +443,52 @@ class DistributedProblem:
     def destroy(self) -> None:
         for obj in (self.ksp, self.A, self.b, self.x, self._x_all, self._gather):
             obj.destroy()
+
+
+class _Assembler:
+    """What the serial Newton loop reads from ``problem.assembler``, on the distributed problem:
+    the interface blocks (``extra``), the replicated internal force and the distributed K_r."""
+
+    def __init__(self, pb: DistributedProblem):
+        self.pb = pb
+
+    @property
+    def extra(self) -> list:
+        return self.pb.extra_blocks
+
+    @property
+    def symmetric(self) -> bool:
+        return all(getattr(b, "symmetric", False) for b in self.extra)
+
+    def evaluate(self, u_full: np.ndarray, tangent: bool = True):
+        """``(f_int, None)``: the full-space tangent is never formed here (use
+        :meth:`evaluate_reduced`)."""
+        if tangent:
+            raise NotImplementedError("the distributed problem forms the reduced tangent only (evaluate_reduced)")
+        return self.pb.internal_force(u_full, False), None
+
+    def evaluate_reduced(self, u_full: np.ndarray, op):
+        """``(f_int, A)``: A = Tᵀ K T assembled in the PETSc matrix (the handle for ``_Solver``)."""
+        if op is not self.pb.op:
+            raise UnsupportedModelError("the constraint operator changed during a distributed run")
+        return self.pb.internal_force(u_full, True), self.pb.A
+
+
+class _Solver:
+    """``solve(K_r, r)`` of :class:`layershell.solver.linear.LinearSolver` by the problem's KSP:
+    K_r must be the matrix the last ``evaluate_reduced`` assembled; ``r`` replicated (n_red,) or
+    (n_red, k); the solution replicated. A failed solve raises ``SingularSystemError`` (the
+    serial Newton turns it into a failed iteration)."""
+
+    def __init__(self, pb: DistributedProblem):
+        self.pb = pb
+
+    def solve(self, Kr, r: np.ndarray) -> np.ndarray:
+        if Kr is not self.pb.A:
+            raise ValueError("the distributed solver solves with the matrix of the last evaluate_reduced")
+        try:
+            if r.ndim == 1:
+                return self.pb.solve_replicated(r)
+            return np.column_stack([self.pb.solve_replicated(r[:, j]) for j in range(r.shape[1])])
+        except SolveError as exc:
+            raise linear.SingularSystemError(str(exc)) from exc
