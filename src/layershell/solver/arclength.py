@@ -156,7 +156,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     ``max_active_set_loops`` times."""
     op, asm = problem.op, problem.assembler
     blocks = _frozen_blocks(problem)
-    seen: set[bytes] = set()
+    seen: dict[bytes, int] = {}
     freeze_sets(blocks, u0, seen)
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
@@ -182,8 +182,9 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         dlam = size / den
     dur = dlam * dut
     for loop in range(s.max_active_set_loops if blocks else 1):
-        if loop > 0:
-            freeze_sets(blocks, att.u, seen)
+        if loop > 0 and not freeze_sets(blocks, att.u, seen):
+            att.message = "the cohesive loading set cycles (no consistent set near this increment)"
+            return _unfrozen(att, blocks)
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left))

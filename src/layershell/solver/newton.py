@@ -119,9 +119,11 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     # then stalls on the way through a softening point (the DCB's crack tip, issue 13); full steps
     # converge there (contact blocks keep it: it helps at the stick/slip transitions)
     s_frozen = replace(s, line_search=False) if cohesive_only else s
-    seen: set[bytes] | None = set() if cohesive_only else None
+    seen: dict[bytes, int] | None = {} if cohesive_only else None
     for _ in range(s.max_active_set_loops):
-        freeze_sets(blocks, u, seen)
+        if not freeze_sets(blocks, u, seen):
+            total.message = "the cohesive loading set cycles (no consistent set near this increment)"
+            break
         left = s.max_contact_iterations - total.iterations
         if left <= 0:
             total.message = _contact_cap_message(total.iterations)
@@ -148,20 +150,27 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     return u, total
 
 
-def freeze_sets(blocks: list, u: np.ndarray, seen: set[bytes] | None) -> None:
+def freeze_sets(blocks: list, u: np.ndarray, seen: dict[bytes, int] | None) -> bool:
     """Freeze the active sets of ``blocks`` at ``u`` for the next iterations of an active-set
     loop. Cohesive blocks (``seen``: the loading sets frozen so far in this loop): where the sets
     they would take now were frozen before - the loop cycles - only the most violated points
-    change (:meth:`~layershell.cohesive.CohesiveBlock.freeze` with ``limited``)."""
+    change (:meth:`~layershell.cohesive.CohesiveBlock.freeze` with ``limited``). Returns False
+    where a set is frozen for the third time: the loop only repeats itself (no consistent set
+    near this increment - a node of a crack front with a local snap-back; the caller fails the
+    increment, which is then cut, instead of iterating to ``max_active_set_loops``)."""
     if seen is None:
         for b in blocks:
             b.freeze(u)
-        return
-    key = b"".join(np.packbits(b.actual_sets(u)[1]).tobytes() for b in blocks)
-    limited = key in seen
+        return True
+    def key_of(sets) -> bytes:
+        return b"".join(np.packbits(a).tobytes() for t, l in sets for a in (t, l))
+
+    limited = key_of([b.actual_sets(u) for b in blocks]) in seen
     for b in blocks:
         b.freeze(u, limited=limited)
-    seen.add(b"".join(np.packbits(b.frozen[1]).tobytes() for b in blocks))
+    key = key_of([b.frozen for b in blocks])
+    seen[key] = seen.get(key, 0) + 1
+    return seen[key] <= 2
 
 
 def _contact_cap_message(iterations: int) -> str:
