@@ -150,6 +150,29 @@ def test_mixed_mode_point_dissipates_bk_fracture_energy(B):
     assert abs(res["summary"]["energy"]["balance_error"]) < 0.01
 
 
+def test_complete_separation_under_prescribed_displacements_converges_without_false_jumps():
+    """The patch separated past complete failure (to 4 λf at B = 0.5) under prescribed
+    displacements: once nothing is attached, the reactions - the residual's scale under
+    displacement control - vanish, and Newton chased round-off ("no convergence towards load
+    factor 0.74", residual 4e-12). The scale now has a floor, 10⁻³ of the largest force scale of
+    the run: every step converges. The reactions are then round-off (|P| < 1e-9 of the peak), and
+    their ratio from step to step is no 'jump' warning any more (before: a dozen)."""
+    import warnings
+
+    from layershell.runner import JumpWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = run(build(parse(_patch_text(0.5, 0.05, np.linspace(0.01, 1, 100)), "patch.toml")), None,
+                write_vtu=False)
+    assert r.converged and len(r.summary["steps"]) == 100
+    P = np.array([np.hypot(s["probes"]["Px"], s["probes"]["Pz"]) for s in r.summary["steps"]])
+    assert P[-1] < 1e-9 * P.max()
+    jumps = [str(w.message) for w in caught if issubclass(w.category, JumpWarning)]
+    assert not [m for m in jumps if "probe" in m], jumps
+    assert len(jumps) == 1 and "debonded area" in jumps[0]  # the real jump: the patch fails at once
+
+
 # ---------------------------------------------------------------------- ENF against beam theory
 L_HALF, A0 = 50.0, 35.0  # half span, initial crack of examples/enf_cohesive.toml
 W_END = 1.95  # prescribed deflection at λ = 1

@@ -15,6 +15,7 @@ import numpy as np
 from . import checkpoint
 from .io.build import RunSpec
 from .recorder import Recorder, read_history
+from .solver.arclength import probe_scales
 from .solver.newton import ConvergenceError, DebondCut, load_steps
 from .solver.problem import Problem
 from .threads import openblas_single_thread
@@ -183,6 +184,9 @@ class _JumpWatch:
         self.lam = prev["load_factor"] if prev else 0.0
         self.probes = prev["probes"] if prev else None
         self.frac = ctl.debonded_fraction() if ctl is not None else None  # after a restart: the restored state
+        self.scales: dict[str, float] = {}  # largest |value| of each probe (round-off is no jump)
+        for s in summary["steps"]:
+            probe_scales(self.scales, s.get("probes"))
 
     def check(self, st, probes: dict, area: dict | None, ctl) -> None:
         import warnings as _w
@@ -191,9 +195,10 @@ class _JumpWatch:
 
         frac = ctl.debonded_fraction() if ctl is not None else None
         msgs = getattr(st, "warnings", None)
+        probe_scales(self.scales, probes)
         if msgs is None:  # fixed steps: checked here (arc length and adaptive steps check, and cut, themselves)
             msgs = jump_warnings(st.step, st.load_factor, self.lam, frac, self.frac, probes, self.probes,
-                                 self.area, self.ratio)
+                                 self.area, self.ratio, self.scales)
         for m in msgs:
             _w.warn(m, JumpWarning, stacklevel=2)
         if msgs:

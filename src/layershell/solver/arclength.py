@@ -273,10 +273,13 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
 
 def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, area_prev: float | None,
                   probes: dict[str, float] | None, probes_prev: dict[str, float] | None,
-                  jump_area: float | None, jump_ratio: float | None) -> list[str]:
+                  jump_area: float | None, jump_ratio: float | None,
+                  scales: dict[str, float] | None = None) -> list[str]:
     """Warnings for a step in which the debonded fraction of the interface grew by more than
     ``jump_area`` or a probe grew more than ``jump_ratio`` times as fast as the load factor
-    (|v/v_prev| > jump_ratio · max(1, |λ/λ_prev|), only where |v_prev| > 0)."""
+    (|v/v_prev| > jump_ratio · max(1, |λ/λ_prev|), only where |v_prev| > 0). ``scales``: the
+    largest |value| of each probe so far; a probe whose two values are both below 10⁻⁹ of it is
+    round-off (a reaction after complete separation), not a jump."""
     out = []
     if jump_area is not None and area is not None and area_prev is not None and area - area_prev > jump_area:
         out.append(f"step {step} (λ = {lam:.6g}): the debonded area jumped from {100 * area_prev:.3g} % to "
@@ -288,10 +291,20 @@ def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, ar
             v0 = probes_prev.get(k)
             if v0 is None or not np.isfinite(v) or not np.isfinite(v0) or abs(v0) <= 1e-12 * max(abs(v), 1e-300):
                 continue
+            if scales and max(abs(v), abs(v0)) <= 1e-9 * scales.get(k, 0.0):
+                continue
             if abs(v / v0) > jump_ratio * grow:
                 out.append(f"step {step} (λ = {lam:.6g}): probe '{k}' jumped from {v0:.6g} to {v:.6g} "
                            f"({abs(v / v0):.3g}× while λ changed {grow:.3g}×)")
     return out
+
+
+def probe_scales(scales: dict[str, float], probes: dict[str, float] | None) -> dict[str, float]:
+    """``scales`` updated with the |values| of ``probes`` (the largest of each so far)."""
+    for k, v in (probes or {}).items():
+        if np.isfinite(v):
+            scales[k] = max(scales.get(k, 0.0), abs(float(v)))
+    return scales
 
 
 def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.ndarray | None = None,
@@ -329,6 +342,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     inc_min = ps.increment * 0.5 ** (ps.max_cuts + 8)
     area_prev = measure(problem) if measure is not None else None
     probes_prev = watch(u, lam) if watch is not None else None
+    scales = probe_scales({}, probes_prev)
     end = ps.lambda_end
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
@@ -384,7 +398,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     and float((att.u - u) @ st.du_prev) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
-                if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio):
+                if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
+                                 scales):
                     ok, msg = False, "probe jump"
             if ok:
                 break
@@ -427,7 +442,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         st.dissipated += dG
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
-        warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio)
+        warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
+                               probe_scales(scales, probes))
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)

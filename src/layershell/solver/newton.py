@@ -208,10 +208,14 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
         scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
         if pres is not None:
             scale = max(ref, float(np.linalg.norm(f[pres] - Fext[pres])), 1e-300)
+        # floor: 10⁻³ of the largest force scale of the run (only acts where the forces have almost
+        # vanished, e.g. a cohesive interface separated completely under prescribed displacements)
+        scale = max(scale, 1e-3 * getattr(problem, "force_scale", 0.0))
         if monitor is not None:
             monitor(it, lam, rn, scale, en, u)
         if it > 0 and rn <= s.tol_residual * scale:
             res.converged, res.iterations = True, it
+            _record_scale(problem, scale)
             return u, res
         if it == s.max_iterations:
             break
@@ -238,6 +242,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
                      or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300))):
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
+            _record_scale(problem, scale)
             return u + dU, res
         f, _ = asm.evaluate(u + dU, tangent=False)
         if globalise and float(np.linalg.norm(op.reduce(Fext - f))) > rn:
@@ -248,6 +253,11 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     res.iterations = s.max_iterations
     res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
     return u, res
+
+
+def _record_scale(problem: Problem, scale: float) -> None:
+    if hasattr(problem, "force_scale"):
+        problem.force_scale = max(problem.force_scale, scale)
 
 
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,

@@ -27,6 +27,10 @@ class Problem:
     solvers: dict = field(default_factory=dict, repr=False)  # backend -> LinearSolver
     # PARDISO's ordering choice per sparsity pattern, kept when the solvers are started afresh
     orderings: dict = field(default_factory=dict, repr=False)
+    # the largest force scale (applied loads or reactions) of a converged state so far: a floor
+    # of the residual's scale, so that Newton can converge where the reactions vanish (complete
+    # separation under prescribed displacements) instead of chasing round-off
+    force_scale: float = 0.0
 
     @classmethod
     def build(cls, model: Model) -> "Problem":

@@ -1,0 +1,88 @@
+"""DCB (mode I, examples/dcb_cohesive.toml) opened under displacement control to δ = 10 mm on
+several meshes (issue 13): speed (steps, Newton iterations, CPU and wall time) and the mesh
+convergence of the answer against corrected beam theory (Williams 1989). Uses the setup of
+tests/test_dcb.py (``displacement_controlled``).
+
+    PYTHONPATH=src python benchmarks/dcb.py                 # 150, 200, 300 elements
+    PYTHONPATH=src python benchmarks/dcb.py 200             # one mesh
+
+Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
+the load at the opening δ = 8 mm (interpolated along the branch), the branch's range against
+beam theory at the compliance-inferred crack length, the dissipated energy against G_Ic b Δa and
+the energy balance. With three meshes the observed order of convergence of P(δ = 8 mm) and of
+the peak, p = ln(|f₁ - f₂| / |f₂ - f₃|) / ln(h₁/h₂) for the spacing ratio of the first pair
+(exact for equal ratios; with unequal ones the formula of Roache (1998) with the two ratios is
+used).
+"""
+from __future__ import annotations
+
+import math
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+import test_dcb as T  # noqa: E402
+
+LENGTH = 150.0
+OPENING = 8.0
+
+
+def measure(nx: int) -> dict:
+    t0, c0 = time.perf_counter(), time.process_time()
+    P, d, summary = T.displacement_controlled(nx)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    pk = int(np.argmax(P))
+    ratio = P[pk + 1:] / T.cbt_load_at(P[pk + 1:], d[pk + 1:])
+    a_end = (d[-1] / P[-1] * T.E11 * T.B * T.H**3 / 8) ** (1 / 3) - T.chi() * T.H
+    e = summary["energy"]
+    return {"nx": nx, "h": LENGTH / (2 * nx), "steps": len(P),
+            "iterations": sum(s["iterations"] for s in summary["steps"]), "cpu": cpu, "wall": wall,
+            "P_max": float(P.max()), "P_8": float(np.interp(OPENING, d, P)),
+            "branch": (float(ratio.min() - 1), float(ratio.max() - 1)) if ratio.size else (math.nan, math.nan),
+            "dissipated": e["dissipated_fracture"] / (T.GIC * T.B * (a_end - T.A0)) - 1,
+            "balance": e["balance_error"], "converged": summary["converged"]}
+
+
+def order(h: list[float], f: list[float]) -> float:
+    """Observed order of convergence from three solutions on spacings h[0] > h[1] > h[2]
+    (Roache 1998 / Celik et al. 2008: fixed-point iteration for unequal refinement ratios)."""
+    r21, r32 = h[1] / h[2], h[0] / h[1]  # 1 = finest
+    e21, e32 = f[1] - f[2], f[0] - f[1]
+    if e21 == 0 or e32 == 0 or e21 * e32 < 0:
+        return math.nan  # not monotone: no asymptotic order
+    p = abs(math.log(abs(e32 / e21))) / math.log(r21)
+    for _ in range(100):
+        q = math.log((r21**p - 1) / (r32**p - 1))
+        p = abs(math.log(abs(e32 / e21)) + q) / math.log(r21)
+    return p
+
+
+def main(argv: list[str]) -> None:
+    meshes = [int(a) for a in argv] or [150, 200, 300]
+    os.environ.setdefault("LAYERSHELL_THREADS", "1")
+    print("| elements | h (mm) | steps | iterations | CPU (s) | wall (s) | P_max (N) | P(δ = 8 mm) (N) | "
+          "branch vs beam theory | dissipated vs G_Ic b Δa | energy balance |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    rows = []
+    for nx in meshes:
+        m = measure(nx)
+        rows.append(m)
+        lo, hi = m["branch"]
+        print(f"| {nx} | {m['h']:.3g} | {m['steps']} | {m['iterations']} | {m['cpu']:.0f} | {m['wall']:.0f} | "
+              f"{m['P_max']:.2f} | {m['P_8']:.2f} | {100 * lo:+.1f} … {100 * hi:+.1f} % | "
+              f"{100 * m['dissipated']:+.1f} % | {100 * m['balance']:.1f} %"
+              + ("" if m["converged"] else " (stopped)") + " |", flush=True)
+    if len(rows) == 3:
+        h = [m["h"] for m in rows]
+        for key in ("P_max", "P_8"):
+            f = [m[key] for m in rows]
+            print(f"{key}: successive differences {f[1] - f[0]:+.3f}, {f[2] - f[1]:+.3f} N; "
+                  f"observed order {order(h, f):.2f}")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
