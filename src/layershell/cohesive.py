@@ -286,6 +286,16 @@ def point_response(delta: np.ndarray, n: np.ndarray, d_old: np.ndarray, K: float
     return (t, d, D, dd) if with_dd else (t, d, D)
 
 
+def cohesive_traction_energy(delta: np.ndarray, n: np.ndarray, d: np.ndarray, K: float):
+    """Traction t = Kδ - dK(<δ_n>n + δ_s) (..., 3) and stored energy ψ = ½K|δ|² - ½dKλ² (...) at
+    separations ``delta`` with the damage ``d`` held fixed (tension where δ_n >= 0)."""
+    dn, ds, lam, _, _, _ = separation_measures(delta, n)
+    g = np.where(dn >= 0, dn, 0.0)[..., None] * n + ds
+    t = K * delta - (K * d)[..., None] * g
+    psi = 0.5 * K * np.einsum("...i,...i->...", delta, delta) - 0.5 * d * K * lam**2
+    return t, psi
+
+
 def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.ndarray:
     """Energy per area dissipated by monotonic damage growth from 0 to ``d`` at the mode ratio B
     (bilinear law, closed form ∫ ½Kλ² dd = ½ K λ0² λf d / (λf - d (λf - λ0)); it reaches G_c(B)

@@ -25,7 +25,8 @@ from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from ..cohesive import FULL_DAMAGE, CohesiveBlock, CohesiveLaw, dissipated, separation_measures
+from ..cohesive import (FULL_DAMAGE, CohesiveBlock, CohesiveLaw, cohesive_traction_energy, dissipated,
+                        separation_measures)
 from ..contact import ContactBlock, friction_shape_inverse
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_delam, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
@@ -61,7 +62,6 @@ class CohesiveRun:
     energy: np.ndarray  # [fracture, friction, viscous] dissipated so far (energy)
     first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
     initial: np.ndarray  # (e, q) points of initially debonded zones
-    Y: np.ndarray  # (e, q) damage driving force ½Kλ² at the last commit (viscous dissipation)
     first_failure: float | None = None  # first point fully debonded
 
     def update(self, u: np.ndarray, lam: float) -> None:
@@ -76,10 +76,20 @@ class CohesiveRun:
         grow = d > d_prev
         # fracture: closed-form dissipation between the old and the new damage at the current mode ratio
         frac = np.where(grow, dissipated(d, B, blk.K, law) - dissipated(d_prev, B, blk.K, law), 0.0)
-        # viscous regularisation: the work of the damage driving force Y = ½Kλ² on the damage
-        # increment (trapezoid) beyond the closed form of the rate-independent law
-        Y = 0.5 * blk.K * lam_eq**2
-        visc = (np.where(grow, 0.5 * (self.Y + Y) * (d - d_prev), 0.0) - frac) if law.viscosity > 0 else 0.0 * Y
+        # viscous regularisation: the work of the cohesive tractions on the separation increment
+        # (trapezoid, the rule of the external work) less the change of the stored energy is the
+        # whole dissipation of the step; beyond the closed form of the rate-independent law it is
+        # viscous. (A trapezoid of the driving force ½Kλ² over the damage increment - the earlier
+        # rule - over-counted where the damage of a point grows a lot within one step: DCB on 300
+        # elements, η = 1e-5: 219 against 206 for fracture, balance error -34 %.) It includes the
+        # step's quadrature error, which the rate-independent ledger leaves in the balance error.
+        if law.viscosity > 0:
+            t0, psi0 = cohesive_traction_energy(self.delta, cb.A3, d_prev, blk.K)
+            _, psi1 = cohesive_traction_energy(delta, cb.A3, d, blk.K)
+            work = 0.5 * np.einsum("eqi,eqi->eq", t0 + t, delta - self.delta)
+            visc = work - (psi1 - psi0) - frac
+        else:
+            visc = np.zeros_like(frac)
         tf = np.zeros_like(t)
         if cb.cap is not None and np.any(cb.cap > 0):
             tf, _ = cb.friction_traction(u, delta)
@@ -89,7 +99,7 @@ class CohesiveRun:
         fric = 0.5 * np.einsum("eqi,eqi->eq", self.t_fric + tf, dslip)
         self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum()),
                                               float((w * visc).sum())])
-        blk.d_old, blk.dv_old, blk.lam_old, self.Y = d_inv, d, float(lam), Y
+        blk.d_old, blk.dv_old, blk.lam_old = d_inv, d, float(lam)
         self.delta, self.t_fric = delta, tf
         fresh = ~self.initial  # initially debonded zones do not count as new damage
         if np.isnan(self.first_damage) and np.any((d > 0) & fresh):
@@ -497,7 +507,7 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
         d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
     blk = CohesiveBlock(cb, law, K, d0, dv_old=d0.copy())
     return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
-                       np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
+                       np.array(np.nan), d0 > 0)
 
 
 def _process_zone_warning(model, r: CohesiveRun) -> list[str]:
