@@ -5,6 +5,7 @@ tests/test_dcb.py (``displacement_controlled``).
 
     PYTHONPATH=src python benchmarks/dcb.py                 # 150, 200, 300 elements
     PYTHONPATH=src python benchmarks/dcb.py 200             # one mesh
+    PYTHONPATH=src python benchmarks/dcb.py 300 --viscosity 1e-6   # with viscous regularisation
 
 Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
 the load at the opening δ = 8 mm (interpolated along the branch), the branch's range against
@@ -31,9 +32,22 @@ LENGTH = 150.0
 OPENING = 8.0
 
 
-def measure(nx: int) -> dict:
+def displacement_controlled(nx: int, viscosity: float = 0.0):
+    """tests/test_dcb.py ``displacement_controlled`` with an optional viscous regularisation."""
+    if viscosity <= 0:
+        return T.displacement_controlled(nx)
+    from helpers import run_example
+
+    r = run_example("dcb_cohesive", {**T.DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}",
+                                     "factors = [0.01, 0.02, 0.05,": "n = 100\nadaptive = true\nincrement_max = 0.02 #",
+                                     "tau_max = 30.0": f"tau_max = 30.0\nviscosity = {viscosity!r}"})
+    steps = r.summary["steps"]
+    return (np.array([s["probes"]["P"] for s in steps]), np.array([T.opening(s) for s in steps]), r.summary)
+
+
+def measure(nx: int, viscosity: float = 0.0) -> dict:
     t0, c0 = time.perf_counter(), time.process_time()
-    P, d, summary = T.displacement_controlled(nx)
+    P, d, summary = displacement_controlled(nx, viscosity)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     pk = int(np.argmax(P))
     ratio = P[pk + 1:] / T.cbt_load_at(P[pk + 1:], d[pk + 1:])
@@ -44,7 +58,8 @@ def measure(nx: int) -> dict:
             "P_max": float(P.max()), "P_8": float(np.interp(OPENING, d, P)),
             "branch": (float(ratio.min() - 1), float(ratio.max() - 1)) if ratio.size else (math.nan, math.nan),
             "dissipated": e["dissipated_fracture"] / (T.GIC * T.B * (a_end - T.A0)) - 1,
-            "balance": e["balance_error"], "converged": summary["converged"]}
+            "balance": e["balance_error"], "converged": summary["converged"],
+            "viscous": e.get("dissipated_viscous", 0.0) / max(e["dissipated_fracture"], 1e-300)}
 
 
 def order(h: list[float], f: list[float]) -> float:
@@ -62,6 +77,11 @@ def order(h: list[float], f: list[float]) -> float:
 
 
 def main(argv: list[str]) -> None:
+    viscosity = 0.0
+    if "--viscosity" in argv:
+        i = argv.index("--viscosity")
+        viscosity = float(argv[i + 1])
+        argv = argv[:i] + argv[i + 2:]
     meshes = [int(a) for a in argv] or [150, 200, 300]
     os.environ.setdefault("LAYERSHELL_THREADS", "1")
     print("| elements | h (mm) | steps | iterations | CPU (s) | wall (s) | P_max (N) | P(δ = 8 mm) (N) | "
@@ -69,13 +89,14 @@ def main(argv: list[str]) -> None:
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for nx in meshes:
-        m = measure(nx)
+        m = measure(nx, viscosity)
         rows.append(m)
         lo, hi = m["branch"]
         print(f"| {nx} | {m['h']:.3g} | {m['steps']} | {m['iterations']} | {m['cpu']:.0f} | {m['wall']:.0f} | "
               f"{m['P_max']:.2f} | {m['P_8']:.2f} | {100 * lo:+.1f} … {100 * hi:+.1f} % | "
               f"{100 * m['dissipated']:+.1f} % | {100 * m['balance']:.1f} %"
-              + ("" if m["converged"] else " (stopped)") + " |", flush=True)
+              + ("" if m["converged"] else " (stopped)")
+              + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 else "") + " |", flush=True)
     if len(rows) == 3:
         h = [m["h"] for m in rows]
         for key in ("P_max", "P_8"):
