@@ -17,17 +17,29 @@ _LOCK = threading.Lock()
 _CONTROLLER = None
 
 
+def controller():
+    """The process's threadpoolctl controller (created once: it inspects the loaded libraries)."""
+    global _CONTROLLER
+    with _LOCK:
+        if _CONTROLLER is None:
+            from threadpoolctl import ThreadpoolController
+
+            _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER
+
+
+def blas_single_thread():
+    """Context limiting every BLAS (OpenBLAS and MKL) to one thread, restoring the setting on
+    exit: the element kernel's per-element products are small, BLAS threads inside them only
+    add synchronisation (and on an oversubscribed machine cost an order of magnitude)."""
+    return controller().limit(limits=1, user_api="blas")
+
+
 def openblas_single_thread():
     """Context holding OpenBLAS (NumPy's and SciPy's BLAS) to one thread; restores the previous
     setting on exit. A no-op context where threadpoolctl or OpenBLAS is missing."""
-    global _CONTROLLER
     try:
-        with _LOCK:
-            if _CONTROLLER is None:
-                from threadpoolctl import ThreadpoolController
-
-                _CONTROLLER = ThreadpoolController()
-        selected = _CONTROLLER.select(internal_api="openblas")
+        selected = controller().select(internal_api="openblas")
     except Exception:  # pragma: no cover - threadpoolctl unusable here
         return contextlib.nullcontext()
     if not selected.lib_controllers:

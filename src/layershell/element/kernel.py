@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..material import Orthotropic, rotate_stiffness
+from ..threads import blas_single_thread
 from .geometry import SurfacePoints, shell_basis, surface_points
 from .quadrature import gauss_1d, gauss_2d
 
@@ -292,7 +293,6 @@ def kernel_threads() -> int:
 
 _POOLS: dict[int, ThreadPoolExecutor] = {}
 _LOCK = threading.Lock()
-_BLAS = None
 
 
 def _pool(n: int) -> ThreadPoolExecutor:
@@ -300,19 +300,6 @@ def _pool(n: int) -> ThreadPoolExecutor:
         if n not in _POOLS:
             _POOLS[n] = ThreadPoolExecutor(n, thread_name_prefix="layershell-kernel")
         return _POOLS[n]
-
-
-def _blas_single_thread():
-    """Context limiting BLAS to one thread (threadpoolctl) while the kernel runs: the per-element
-    products are small, BLAS threads inside them only add synchronisation (and on an oversubscribed
-    machine cost an order of magnitude). Restores the previous setting on exit."""
-    global _BLAS
-    with _LOCK:
-        if _BLAS is None:
-            from threadpoolctl import ThreadpoolController
-
-            _BLAS = ThreadpoolController()
-    return _BLAS.limit(limits=1, user_api="blas")
 
 
 def layer_response(
@@ -341,7 +328,7 @@ def layer_response(
     f = np.empty((e, a, 3))
     K = np.empty((e, m, m)) if tangent else None
     n_threads = min(kernel_threads(), max(1, e // _SUB))
-    with _blas_single_thread() if tangent else nullcontext():
+    with blas_single_thread() if tangent else nullcontext():
         if n_threads == 1:
             _response_range(g, dV, C, L, U, nonlinear, tangent, f, K, 0, e)
         else:

@@ -350,7 +350,8 @@ def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tange
     """Internal force ``(e, m)`` and tangent ``(e, m, m)`` of a MITC9 layer block (compiled point
     work, one BLAS syrk per element for the material part, elements over threads as in
     :func:`kernel.layer_response`); equal to :func:`mitc_response_reference` to round-off."""
-    from .kernel import _blas_single_thread, _pool, kernel_threads
+    from ..threads import blas_single_thread
+    from .kernel import _pool, kernel_threads
     from contextlib import nullcontext
 
     n_all = block.thL.shape[0]
@@ -365,7 +366,7 @@ def mitc_response(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tange
     f = np.empty((e, m))
     K = np.empty((e, m, m)) if tangent else None
     n_threads = min(kernel_threads(), max(1, e // _SUB))
-    with _blas_single_thread() if tangent else nullcontext():
+    with blas_single_thread() if tangent else nullcontext():
         if n_threads == 1:
             _mitc_range(block, lo0, U, nonlinear, tangent, f, K, 0, e)
         else:
