@@ -367,7 +367,9 @@ class CohesiveBlock:
     def actual_sets(self, u_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(tension, loading) of every point at ``u_full``: δ_n >= 0, and the points whose damage
         grows (trial damage, continued below the onset, above the history)."""
-        g, dt = self._trial(u_full)
+        return self._sets(*self._trial(u_full))
+
+    def _sets(self, g: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
         return g >= 0, loading
 
@@ -388,10 +390,10 @@ class CohesiveBlock:
         node, all points of the front loading unloads two of them, and without those they load
         again - while a set in between is (the standard remedy for a cycling primal-dual active
         set, cf. Hintermüller, Ito & Kunisch 2002)."""
-        tension, loading = self.actual_sets(u_full)
+        g, dt = self._trial(u_full)
+        tension, loading = self._sets(g, dt)
         if limited and self.frozen is not None and self.frozen[1] is not None:
             prev = self.frozen[1]
-            _, dt = self._trial(u_full)
             viol = np.where(loading != prev, np.abs(dt - self.d_old), 0.0)
             worst = float(viol.max())
             if worst > 0.0:

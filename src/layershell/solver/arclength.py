@@ -35,7 +35,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import ConvergenceError, NewtonSettings, StepResult, freeze_sets, newton
+from .newton import ConvergenceError, NewtonSettings, StepResult, active_set_blocks, freeze_sets, newton
 from .problem import Problem
 
 
@@ -135,12 +135,10 @@ def _frozen_blocks(problem: Problem) -> list:
     (semi-smooth; unfrozen here). Cohesive interfaces (``smooth_when_frozen``): returned, for the
     active-set loop of :func:`arc_attempt`, as in :func:`~layershell.solver.newton.newton` (the
     semi-smooth iteration cycles at the kink of the law at the onset of damage)."""
-    blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
+    blocks, cohesive_only = active_set_blocks(problem)
     for b in blocks:
         b.unfreeze()
-    if blocks and all(getattr(b, "smooth_when_frozen", False) for b in blocks):
-        return blocks
-    return []
+    return blocks if cohesive_only else []
 
 
 def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,

@@ -85,10 +85,9 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     that has not settled after ``max_active_set_loops`` is a failure (the step is cut), not an
     accepted state."""
     u = problem.impose(u, lam)  # prescribed displacements at this load factor (displacement control)
-    blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
+    blocks, cohesive_only = active_set_blocks(problem)
     if not blocks:
         return newton_fixed_set(problem, u, lam, s)
-    cohesive_only = all(getattr(b, "smooth_when_frozen", False) for b in blocks)
     # cohesive interfaces: no semi-smooth iterations - they cycle at the onset of damage (the kink
     # at λ0); the active-set loop converges there, and as fast on the easy steps (DCB to
     # δ = 10 mm: 590 iterations against 879 with 8 semi-smooth ones first)
@@ -148,6 +147,13 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     for b in blocks:
         b.unfreeze()
     return u, total
+
+
+def active_set_blocks(problem: Problem) -> tuple[list, bool]:
+    """The blocks with an active set (contact, cohesive interfaces: ``freeze``) and whether all
+    of them are cohesive (``smooth_when_frozen``: active-set loop only, no semi-smooth phase)."""
+    blocks = [b for b in problem.assembler.extra if hasattr(b, "freeze")]
+    return blocks, bool(blocks) and all(getattr(b, "smooth_when_frozen", False) for b in blocks)
 
 
 def freeze_sets(blocks: list, u: np.ndarray, seen: dict[bytes, int] | None) -> bool:
