@@ -176,7 +176,13 @@ class ActiveSetLoop:
         self.best: tuple[float, object] | None = None
 
     def freeze(self, u: np.ndarray) -> bool:
-        """Freeze the sets at ``u`` (:func:`freeze_sets`); False where the loop cycles."""
+        """Freeze the sets at ``u`` (:func:`freeze_sets`); False where the loop cycles - also,
+        without further loops, where the sets of ``u`` were frozen before and a state within
+        the tolerance is at hand (the limited changes of :func:`freeze_sets` would only look for
+        an exactly consistent set near it)."""
+        if (self.seen is not None and self.best is not None and self.best[0] <= self.tol
+                and _sets_key([b.actual_sets(u) for b in self.blocks]) in self.seen):
+            return False
         return freeze_sets(self.blocks, u, self.seen)
 
     def consistent(self, u: np.ndarray, state: object) -> bool:
@@ -198,8 +204,9 @@ class ActiveSetLoop:
         """The remembered state if its violation is within the tolerance (counted on ``problem``), else None."""
         if self.best is None or not self.best[0] <= self.tol:
             return None
-        problem.accepted_sets += 1
-        problem.accepted_violation = max(problem.accepted_violation, self.best[0])
+        if hasattr(problem, "accepted_sets"):
+            problem.accepted_sets += 1
+            problem.accepted_violation = max(problem.accepted_violation, self.best[0])
         return self.best[1]
 
     def accepted_message(self) -> str:
@@ -226,15 +233,17 @@ def freeze_sets(blocks: list, u: np.ndarray, seen: dict[bytes, int] | None) -> b
         for b in blocks:
             b.freeze(u)
         return True
-    def key_of(sets) -> bytes:
-        return b"".join(np.packbits(a).tobytes() for t, l in sets for a in (t, l))
-
-    limited = key_of([b.actual_sets(u) for b in blocks]) in seen
+    limited = _sets_key([b.actual_sets(u) for b in blocks]) in seen
     for b in blocks:
         b.freeze(u, limited=limited)
-    key = key_of([b.frozen for b in blocks])
+    key = _sets_key([b.frozen for b in blocks])
     seen[key] = seen.get(key, 0) + 1
     return seen[key] <= 2
+
+
+def _sets_key(sets: list[tuple[np.ndarray, np.ndarray]]) -> bytes:
+    """The (tension, loading) sets of all blocks as one hashable key."""
+    return b"".join(np.packbits(a).tobytes() for t, l in sets for a in (t, l))
 
 
 def _contact_cap_message(iterations: int) -> str:
