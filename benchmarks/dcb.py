@@ -13,7 +13,9 @@ beam theory at the compliance-inferred crack length, the dissipated energy again
 the energy balance. With three meshes the observed order of convergence of P(δ = 8 mm) and of
 the peak, p = ln(|f₁ - f₂| / |f₂ - f₃|) / ln(h₁/h₂) for the spacing ratio of the first pair
 (exact for equal ratios; with unequal ones the formula of Roache (1998) with the two ratios is
-used).
+used), and the order at which the largest deviation of the branch from beam theory falls. The
+last column counts the states the cohesive active-set loop accepted within its consistency
+tolerance (solver/newton.py ActiveSetLoop) and their largest violation (fraction of the strength).
 """
 from __future__ import annotations
 
@@ -59,7 +61,9 @@ def measure(nx: int, viscosity: float = 0.0) -> dict:
             "branch": (float(ratio.min() - 1), float(ratio.max() - 1)) if ratio.size else (math.nan, math.nan),
             "dissipated": e["dissipated_fracture"] / (T.GIC * T.B * (a_end - T.A0)) - 1,
             "balance": e["balance_error"], "converged": summary["converged"],
-            "viscous": e.get("dissipated_viscous", 0.0) / max(e["dissipated_fracture"], 1e-300)}
+            "viscous": e.get("dissipated_viscous", 0.0) / max(e["dissipated_fracture"], 1e-300),
+            "accepted": summary.get("active_set", {}).get("accepted_within_tolerance", 0),
+            "violation": summary.get("active_set", {}).get("largest_violation", 0.0)}
 
 
 def order(h: list[float], f: list[float]) -> float:
@@ -85,8 +89,8 @@ def main(argv: list[str]) -> None:
     meshes = [int(a) for a in argv] or [150, 200, 300]
     os.environ.setdefault("LAYERSHELL_THREADS", "1")
     print("| elements | h (mm) | steps | iterations | CPU (s) | wall (s) | P_max (N) | P(δ = 8 mm) (N) | "
-          "branch vs beam theory | dissipated vs G_Ic b Δa | energy balance |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+          "branch vs beam theory | dissipated vs G_Ic b Δa | energy balance | sets accepted (largest violation) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for nx in meshes:
         m = measure(nx, viscosity)
@@ -96,13 +100,18 @@ def main(argv: list[str]) -> None:
               f"{m['P_max']:.2f} | {m['P_8']:.2f} | {100 * lo:+.1f} … {100 * hi:+.1f} % | "
               f"{100 * m['dissipated']:+.1f} % | {100 * m['balance']:.1f} %"
               + ("" if m["converged"] else " (stopped)")
-              + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 else "") + " |", flush=True)
+              + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 else "")
+              + f" | {m['accepted']} ({m['violation']:.1e}) |", flush=True)
     if len(rows) == 3:
         h = [m["h"] for m in rows]
         for key in ("P_max", "P_8"):
             f = [m[key] for m in rows]
             print(f"{key}: successive differences {f[1] - f[0]:+.3f}, {f[2] - f[1]:+.3f} N; "
                   f"observed order {order(h, f):.2f}")
+        dev = [max(abs(v) for v in m["branch"]) for m in rows]  # against beam theory (the reference)
+        print("largest branch deviation from beam theory: " + ", ".join(f"{100 * v:.2f} %" for v in dev)
+              + "; orders " + ", ".join(f"{math.log(dev[i] / dev[i + 1]) / math.log(h[i] / h[i + 1]):.2f}"
+                                        for i in range(2)))
 
 
 if __name__ == "__main__":
