@@ -363,7 +363,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if ctl is not None and ctl.energies(problem, np.zeros(problem.dm.n_full)) is not None else [])
     if energy_names:
         summary.update(first_damage_load_factor=None, peak_load_factor=None, energy=None)
-        if ctl.warnings:  # e.g. a process zone covered by fewer than 3 node spacings: console and summary.json
+        if ctl.warnings:  # set-up warnings of the interfaces: console and summary.json
             import warnings as _w
 
             summary.setdefault("warnings", []).extend(ctl.warnings)
@@ -426,6 +426,14 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     def on_step_end(pb, uu, lam):
         before = debonded_total()
         again = ctl.update(pb, uu, lam)
+        if ctl.new_warnings:  # a process zone covered by fewer than 3 node spacings (when damage starts)
+            import warnings as _w
+
+            summary.setdefault("warnings", []).extend(ctl.new_warnings)
+            for m in ctl.new_warnings:
+                _w.warn(m, CohesiveWarning, stacklevel=2)
+                log(f"warning: {m}")
+            ctl.new_warnings.clear()
         resolves["n"] += int(again)
         after = debonded_total()
         if again or after != before:
