@@ -204,3 +204,29 @@ def test_mode_i_slender_limit_scaling():
     assert II2 / II1 == pytest.approx(2 ** 0.5, rel=1e-3) and II3 / II1 == pytest.approx(4.0, rel=1e-3)
     # mode II, rigid-plastic onset: l = π/(2λ), λ² = c τ0/δf, c = 8/(E h) for two equal arms
     assert II1 == pytest.approx(np.pi / 2 / np.sqrt(8 / 1e5 * 10.0 / 0.02), rel=1e-3)
+
+
+def test_modulus_along_the_crack_direction():
+    """The arms' modulus is the in-plane modulus along the finer mesh direction (where the front
+    runs): E1 along the fibres, E2 across them (the DCB with `direction = [0, 1, 0]` has a mode-I
+    zone (11/150)^(1/4) as long: c_I = Σ 12/(E h³) changes, the foundation does not), the
+    transverse shear modulus
+    G31 → G23; an isotropic layer has E in every direction."""
+    from layershell.material import Orthotropic
+    from layershell.process_zone import in_plane_modulus
+
+    m = Orthotropic(150000.0, 11000.0, 11000.0, 6000.0, 3700.0, 6000.0, 0.25, 0.45, 0.0183)
+    assert in_plane_modulus(m, 0.0) == pytest.approx((150000.0, 6000.0))
+    assert in_plane_modulus(m, np.pi / 2) == pytest.approx((11000.0, 3700.0))
+    iso = Orthotropic.isotropic(30000.0, 0.2)
+    assert in_plane_modulus(iso, 0.7)[0] == pytest.approx(30000.0)
+    from helpers import EXAMPLES
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text()
+    ests = []
+    for t in (text, text.replace("direction = [1, 0, 0]", "direction = [0, 1, 0]")):
+        spec = build(parse(t, "dcb"), EXAMPLES)
+        est, h, e = process_zone_estimate(spec.model, Problem.build(spec.model).interfaces.runs[0])
+        assert e == pytest.approx([1.0, 0.0, 0.0]) and h == pytest.approx(0.5)
+        ests.append(est["I"]["slender"])
+    assert ests[1] / ests[0] == pytest.approx((11 / 150) ** 0.25, rel=1e-9)

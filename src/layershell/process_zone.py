@@ -97,7 +97,7 @@ def zone_lengths(G_Ic: float, G_IIc: float, sigma_max: float, tau_max: float, K:
                 c = sum(12.0 / (a.E * a.h**3) for a in arms)
                 x = _x_mode_i(r)
                 if np.isfinite(x):
-                    slender = x / (c * s / (df - d0)) ** 0.25
+                    slender = float(x / (c * s / (df - d0)) ** 0.25)
             else:
                 c = (sum(1.0 / (a.E * a.h) for a in arms)
                      + 3 * sum(a.h for a in arms) ** 2 / sum(a.E * a.h**3 for a in arms))

@@ -517,34 +517,32 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
                        np.array(np.nan), d0 > 0)
 
 
-def _arm(model, k: int, direction: np.ndarray) -> Arm:
-    """Layer ``k`` as an arm of the process-zone estimate along the unit ``direction``: its
-    smallest thickness, in-plane modulus and transverse shear modulus along that direction,
-    E3. A layer held by supports at every node (all directors and components, e.g. a rigid
-    substrate) is rigid."""
+def _arm(model, k: int, direction: np.ndarray, normal: np.ndarray) -> Arm:
+    """Layer ``k`` as an arm of the process-zone estimate along the unit ``direction`` (in the
+    plane with unit ``normal``): its smallest thickness, in-plane modulus and transverse shear
+    modulus along that direction, E3. A layer held by supports at every node (all directors and
+    components, e.g. a rigid substrate) is rigid."""
     ly = model.layers[k]
     mat = ly.material
     if _held(model, k):
         return Arm(float(ly.thickness.min()), np.inf, np.inf, np.inf)
     a1 = np.asarray(ly.direction, float) if ly.direction is not None else np.array([1.0, 0.0, 0.0])
-    c = abs(float(a1 @ direction)) / max(float(np.linalg.norm(a1)), 1e-300)
-    angle = float(np.arccos(min(c, 1.0))) + ly.angle
-    E, G = in_plane_modulus(mat, angle)
+    a1 = a1 - (a1 @ normal) * normal  # its tangent-plane projection; the material axis 1 is at ω from it
+    theta = float(np.arctan2(np.cross(a1, direction) @ normal, a1 @ direction))
+    E, G = in_plane_modulus(mat, theta - ly.angle)
     return Arm(float(ly.thickness.min()), E, mat.E3, G)
 
 
 def _held(model, k: int) -> bool:
     """True where supports fix every director and component of layer ``k`` at all its nodes."""
-    nodes = np.flatnonzero(np.ones(model.mesh.n_nodes, bool))
     held = np.zeros((model.mesh.n_nodes, model.layers[k].directors + 1, 3), bool)
     for f in model.fixes:
-        if f.layer != k:
-            continue
-        dirs = [d for d in f.directors if d <= model.layers[k].directors]
-        held[np.ix_(np.asarray(f.nodes), dirs, list(f.components))] = True
-    present = np.zeros(model.mesh.n_nodes, bool)
-    present[np.unique(model.mesh.elements[[e for e, st in enumerate(model.element_stack) if k in model.stacks[st]]])] = True
-    return bool(held[nodes[present]].all()) if present.any() else False
+        if f.layer == k:
+            dirs = [d for d in f.directors if d <= model.layers[k].directors]
+            held[np.ix_(np.asarray(f.nodes), dirs, list(f.components))] = True
+    stacks = [i for i, st in enumerate(model.stacks) if k in st]
+    nodes = np.unique(model.mesh.elements[np.isin(model.element_stack, stacks)])
+    return bool(nodes.size) and bool(held[nodes].all())
 
 
 def process_zone_estimate(model, r: CohesiveRun) -> tuple[dict, float, np.ndarray]:
@@ -558,11 +556,13 @@ def process_zone_estimate(model, r: CohesiveRun) -> tuple[dict, float, np.ndarra
     n1, n3 = np.linalg.norm(s1, axis=-1), np.linalg.norm(s3, axis=-1)
     i1, i3 = int(np.argmax(n1)), int(np.argmax(n3))
     if n1[i1] <= n3[i3]:
-        h, e = 0.5 * n1[i1], s1[i1] / n1[i1]
+        h, e, i = 0.5 * n1[i1], s1[i1] / n1[i1], i1
     else:
-        h, e = 0.5 * n3[i3], s3[i3] / n3[i3]
+        h, e, i = 0.5 * n3[i3], s3[i3] / n3[i3], i3
+    nrm = np.cross(s1[i], s3[i])
+    nrm = nrm / np.linalg.norm(nrm)
     law = r.law
-    arms = (_arm(model, cb.itf.lower, e), _arm(model, cb.itf.upper, e))
+    arms = (_arm(model, cb.itf.lower, e, nrm), _arm(model, cb.itf.upper, e, nrm))
     return zone_lengths(law.G_Ic, law.G_IIc, law.sigma_max, law.tau_max, r.block.K, arms), float(h), e
 
 
