@@ -32,6 +32,14 @@ r = (δf − δ0)/δ0:
   (y = δf − δ = A (cosh − cos) + B (sinh + sin) of μs) to the elastic foundation ahead
   (δ = δ0 e^(−βt)(cos βt + F sin βt), (β/μ)⁴ = r/4) in slope, moment and shear (:func:`_x_mode_i`).
 
+References: Hillerborg, Modéer & Petersson (1976), Cem. Concr. Res. 6, 773-782; Kanninen (1973),
+Int. J. Fract. 9, 83-92 (augmented DCB: arms on an elastic foundation of the half thickness);
+Yang & Cox (2005), Int. J. Fract. 133, 107-137; Harper & Hallett (2008), Eng. Fract. Mech. 75,
+4774-4792; Yuan, Teng, Seracino, Wu & Yao (2004), Eng. Struct. 26, 553-565; Turon, Dávila,
+Camanho & Costa (2007), Eng. Fract. Mech. 74, 1665-1682. Soto et al. (2016, "Cohesive zone length
+of orthotropic materials undergoing delamination", Eng. Fract. Mech.) fit empirical prefactors
+for orthotropic arms; the prefactors here are not fitted.
+
 Where the effective law has no softening branch (r ≤ 0: the layers' own compliance stores
 more than G_c before the onset) the slender estimate does not apply and l_inf is used.
 The FE check (tests/test_process_zone.py) measures the zone along the crack in the DCB and ENF
