@@ -228,3 +228,60 @@ def test_process_zone_warning():
              write_vtu=False).summary
     assert ok["first_damage_load_factor"] == 0.5
     assert not [w for w in ok.get("warnings", []) if "process zone" in w]
+
+
+def test_set_violation_is_the_traction_change_of_the_actual_sets():
+    """The violation measure of a frozen active set (the criterion under which a cycling loop may
+    accept a state) equals, independently computed, the largest change of the traction between
+    the frozen response and the response with the actual sets, per point over its strength
+    K λ0(B); and it is 0 where the sets are those of the state."""
+    from layershell.cohesive import onset, point_response, separation_measures
+
+    pb, blk, ur = _damaged_problem("lobatto")
+    u0 = pb.op.T @ ur
+    blk.freeze(u0)
+    assert blk.set_violation(u0) == 0.0 and not blk.set_changed(u0)
+    rng = np.random.default_rng(11)
+    u1 = u0 + pb.op.T @ (0.3 * rng.normal(size=ur.shape) * np.abs(ur).max())
+    n = blk.contact.A3
+    delta = blk.separation(u1)
+    tf, _, _ = point_response(delta, n, blk.d_old, blk.K, blk.law, tangent=False, frozen=blk.frozen)
+    ta, _, _ = point_response(delta, n, blk.d_old, blk.K, blk.law, tangent=False)
+    _, _, _, B, _, _ = separation_measures(delta, n)
+    l0, _ = onset(B, blk.K, blk.law)
+    expected = (np.linalg.norm(tf - ta, axis=-1) / (blk.K * l0)).max()
+    v = blk.set_violation(u1)
+    assert blk.set_changed(u1) and expected > 1e-3  # points changed their state
+    assert v == pytest.approx(expected, rel=1e-9)
+    blk.unfreeze()
+
+
+def test_active_set_loop_accepts_a_cycling_state_only_within_the_tolerance():
+    """ActiveSetLoop: a converged state with sets violated by less than the tolerance is
+    accepted (and counted) when the loop fails; one violated by more is not."""
+    from types import SimpleNamespace
+
+    from layershell.solver.newton import ActiveSetLoop
+
+    class Fake:
+        CONSISTENCY_TOL = 1e-3
+        smooth_when_frozen = True
+        v = 0.0
+
+        def set_violation(self, u):
+            return self.v
+
+    for v, accepted in ((5e-4, True), (2e-3, False)):
+        b = Fake()
+        loop = ActiveSetLoop([b], True)
+        pb = SimpleNamespace(accepted_sets=0, accepted_violation=0.0)
+        b.v = 1e-2
+        assert not loop.consistent(None, "far")
+        b.v = v
+        assert not loop.consistent(None, "near")
+        b.v = 0.5
+        assert not loop.consistent(None, "farther")
+        assert loop.accept(pb) == ("near" if accepted else None)
+        assert pb.accepted_sets == int(accepted) and pb.accepted_violation == (v if accepted else 0.0)
+        b.v = 0.0
+        assert loop.consistent(None, "exact")

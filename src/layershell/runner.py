@@ -515,6 +515,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     summary["energy"] = energy
                     summary["first_damage_load_factor"] = ctl.first_damage()
                     summary["peak_load_factor"] = max(float(st.load_factor), summary["peak_load_factor"] or 0.0)
+                if problem.accepted_sets:  # cohesive active sets accepted within their tolerance (solver/newton.py)
+                    summary["active_set"] = {"accepted_within_tolerance": problem.accepted_sets,
+                                             "largest_violation": problem.accepted_violation}
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals

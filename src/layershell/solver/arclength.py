@@ -35,7 +35,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import ConvergenceError, NewtonSettings, StepResult, active_set_blocks, freeze_sets, newton
+from .newton import ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, newton
 from .problem import Problem
 
 
@@ -154,8 +154,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     ``max_active_set_loops`` times."""
     op, asm = problem.op, problem.assembler
     blocks = _frozen_blocks(problem)
-    seen: dict[bytes, int] = {}
-    freeze_sets(blocks, u0, seen)
+    loop = ActiveSetLoop(blocks, True)
+    loop.freeze(u0)
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend)
@@ -179,24 +179,31 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             return _unfrozen(att, blocks)
         dlam = size / den
     dur = dlam * dut
-    for loop in range(s.max_active_set_loops if blocks else 1):
-        if loop > 0 and not freeze_sets(blocks, att.u, seen):
+    for k in range(s.max_active_set_loops if blocks else 1):
+        if k > 0 and not loop.freeze(att.u):
             att.message = "the cohesive loading set cycles (no consistent set near this increment)"
-            return _unfrozen(att, blocks)
+            return _unfrozen(att, blocks, loop, problem)
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left))
         if not ok:
-            return _unfrozen(att, blocks)
-        if not any(b.set_changed(att.u) for b in blocks):
+            return _unfrozen(att, blocks, loop, problem)
+        if loop.consistent(att.u, (att.u, att.lam)):
             att.converged = True
-            return _unfrozen(att, blocks)
+            return _unfrozen(att, blocks, loop, problem)
     att.converged = False
     att.message = "cohesive loading set still changing after the allowed active-set loops"
-    return _unfrozen(att, blocks)
+    return _unfrozen(att, blocks, loop, problem)
 
 
-def _unfrozen(att: Attempt, blocks: list) -> Attempt:
+def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, problem: Problem | None = None) -> Attempt:
+    """Unfreeze the blocks; a failed attempt takes the loop's accepted state, if any
+    (:class:`~layershell.solver.newton.ActiveSetLoop`)."""
+    if loop is not None and not att.converged:
+        accepted = loop.accept(problem)
+        if accepted is not None:
+            att.u, att.lam = accepted
+            att.converged, att.message = True, loop.accepted_message()
     for b in blocks:
         b.unfreeze()
     return att

@@ -31,6 +31,11 @@ class Problem:
     # of the residual's scale, so that Newton can converge where the reactions vanish (complete
     # separation under prescribed displacements) instead of chasing round-off
     force_scale: float = 0.0
+    # cohesive active sets accepted within their consistency tolerance where the loop cycled
+    # (solver/newton.py ActiveSetLoop): how many, and the largest violation (fraction of the
+    # strength); reported in summary.json "active_set"
+    accepted_sets: int = 0
+    accepted_violation: float = 0.0
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
