@@ -204,13 +204,30 @@ def test_viscous_regularisation_reports_its_dissipation():
 
 
 def test_process_zone_warning():
-    """l_cz = E G_c / τ0² (Turon et al. 2007) against the node spacing (strip: 12.5 mm elements,
-    6.25 mm node spacing): strengths of 1 N/mm² give l_cz = 30000 × 0.5 / 1 = 15 km (no warning),
-    strengths of 1000 N/mm² give 15 mm = 2.4 spacings (warning naming the interface)."""
-    ok = run(strip(nx=8, cohesive={"smax": 1.0, "tmax": 1.0}), None, write_vtu=False).summary
-    assert "warnings" not in ok
-    bad = run(strip(nx=8, cohesive={"smax": 30.0, "tmax": 30.0}), None, write_vtu=False).summary
-    assert len(bad["warnings"]) == 1 and "lower/upper" in bad["warnings"][0] and "2.67 node spacings" in bad["warnings"][0]
+    """The process zone (layershell.process_zone) against the node spacing, checked when damage
+    starts with the mode of the damaging points. Strip (E = 30 GPa, layers 5 and 3 mm, strengths
+    10 N/mm², G_IIc = 1 N/mm) bent as a cantilever: damage starts at the clamp in shear
+    (G_II/G = 1.00) and the mode-II zone is 26.2 mm (shear lag, tan(λl) = sqrt(r)); with 2
+    elements along the strip the node spacing is 10 mm (half the 20 mm width, the shorter
+    side): 2.62 spacings, a warning naming the interface and the mode; with 16 elements
+    (h = 3.125 mm) none."""
+    import warnings
+
+    from layershell.runner import CohesiveWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        bad = run(strip(nx=2, load="12.0", steps=6, cohesive={"smax": 10.0, "tmax": 10.0}), None,
+                  write_vtu=False).summary
+    zone = [w for w in bad["warnings"] if "process zone" in w]
+    assert bad["first_damage_load_factor"] == 0.5
+    assert len(zone) == 1 and "lower/upper" in zone[0] and "G_II/G = 1.00" in zone[0]
+    assert "estimated at 26.17" in zone[0] and "2.62 node spacings" in zone[0]
+    assert any(issubclass(c.category, CohesiveWarning) for c in caught)  # on the console too
+    ok = run(strip(nx=16, load="12.0", steps=6, cohesive={"smax": 10.0, "tmax": 10.0}), None,
+             write_vtu=False).summary
+    assert ok["first_damage_load_factor"] == 0.5
+    assert not [w for w in ok.get("warnings", []) if "process zone" in w]
 
 
 def test_set_violation_is_the_traction_change_of_the_actual_sets():

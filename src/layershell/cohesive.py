@@ -101,7 +101,9 @@ class CohesiveLaw:
         return self.G_Ic + (self.G_IIc - self.G_Ic) * np.asarray(B, float) ** self.eta
 
     def process_zone_length(self, E: float) -> float:
-        """l_cz = E G_c / τ0² with the smaller of the two modes' ratios (Turon et al. 2007, M = 1)."""
+        """l_cz = E G_c / τ0² with the smaller of the two modes' ratios (Turon et al. 2007, M = 1):
+        the process zone in a thick body. Slender layers have other lengths (mode I much shorter
+        in a DCB): the process-zone warning uses :mod:`layershell.process_zone`."""
         return E * min(self.G_Ic / self.sigma_max**2, self.G_IIc / self.tau_max**2)
 
 

@@ -163,7 +163,34 @@ def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck,
 
     return path_steps(problem, spec.newton, spec.path_following, u0=u, lam0=lam0, step0=step0, state=state,
                       on_step_end=on_step_end, measure=(lambda pb: pb.interfaces.debonded_fraction())
-                      if ctl is not None else None, watch=watch if spec.probes else None)
+                      if ctl is not None else None, watch=watch if spec.probes else None,
+                      floors=_ProbeFloors(spec, problem))
+
+
+class _ProbeFloors:
+    """Noise floors of the probes for the jump check (:func:`~layershell.solver.arclength.jump_warnings`):
+    a reaction probe ρ·(f_int − F_ext) is computed from a state whose residual the Newton loop
+    only brought below ``tol_residual`` × the force scale of the run (``Problem.force_scale``,
+    solver/newton.py), so by Cauchy–Schwarz it is resolved only beyond
+    |scale| · ‖ρ‖ · tol_residual · force_scale. Below that it is round-off - e.g. the sum of the
+    reactions that equilibrium makes zero (the DCB's P_all: ~1e-8 N against 60 N loads) - and
+    its ratio between two steps means nothing. Other probes get no floor."""
+
+    def __init__(self, spec: RunSpec, problem: Problem):
+        self.spec, self.problem = spec, problem
+        self.norms: dict[str, float] = {}
+
+    def __call__(self) -> dict[str, float]:
+        pb, spec = self.problem, self.spec
+        scale = float(getattr(pb, "force_scale", 0.0)) * spec.newton.tol_residual
+        out = {}
+        for p in spec.probes:
+            if p.quantity != "reaction":
+                continue
+            if p.name not in self.norms:
+                self.norms[p.name] = float(np.linalg.norm(p.rigid_mode(spec.model, pb.dm)))
+            out[p.name] = abs(p.scale) * self.norms[p.name] * scale
+        return out
 
 
 def _path_arrays(st) -> dict[str, np.ndarray]:
@@ -176,9 +203,10 @@ class _JumpWatch:
     [steps] jump_area of the interface or a probe grows more than jump_ratio times as fast as λ
     gets a warning on the console (a UserWarning) and in summary.json 'warnings'."""
 
-    def __init__(self, spec: RunSpec, summary: dict, ctl):
+    def __init__(self, spec: RunSpec, summary: dict, ctl, floors: "_ProbeFloors | None" = None):
         st = spec.source.steps
         self.area, self.ratio = st.jump_area, st.jump_ratio
+        self.floors = floors  # noise floors of reaction probes (round-off is no jump)
         self.summary = summary
         prev = summary["steps"][-1] if summary["steps"] else None
         self.lam = prev["load_factor"] if prev else 0.0
@@ -198,7 +226,7 @@ class _JumpWatch:
         probe_scales(self.scales, probes)
         if msgs is None:  # fixed steps: checked here (arc length and adaptive steps check, and cut, themselves)
             msgs = jump_warnings(st.step, st.load_factor, self.lam, frac, self.frac, probes, self.probes,
-                                 self.area, self.ratio, self.scales)
+                                 self.area, self.ratio, self.scales, self.floors() if self.floors is not None else None)
         for m in msgs:
             _w.warn(m, JumpWarning, stacklevel=2)
         if msgs:
@@ -335,7 +363,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if ctl is not None and ctl.energies(problem, np.zeros(problem.dm.n_full)) is not None else [])
     if energy_names:
         summary.update(first_damage_load_factor=None, peak_load_factor=None, energy=None)
-        if ctl.warnings:  # e.g. a process zone covered by fewer than 3 node spacings: console and summary.json
+        if ctl.warnings:  # set-up warnings of the interfaces: console and summary.json
             import warnings as _w
 
             summary.setdefault("warnings", []).extend(ctl.warnings)
@@ -398,6 +426,14 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     def on_step_end(pb, uu, lam):
         before = debonded_total()
         again = ctl.update(pb, uu, lam)
+        if ctl.new_warnings:  # a process zone covered by fewer than 3 node spacings (when damage starts)
+            import warnings as _w
+
+            summary.setdefault("warnings", []).extend(ctl.new_warnings)
+            for m in ctl.new_warnings:
+                _w.warn(m, CohesiveWarning, stacklevel=2)
+                log(f"warning: {m}")
+            ctl.new_warnings.clear()
         resolves["n"] += int(again)
         after = debonded_total()
         if again or after != before:
@@ -446,7 +482,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                  if step0 < n_steps else ())
         if spec.path_following is not None:  # arc length / adaptive steps (solver/arclength.py)
             steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None)
-        jumps = _JumpWatch(spec, summary, ctl)
+        jumps = _JumpWatch(spec, summary, ctl, _ProbeFloors(spec, problem))
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u

@@ -279,12 +279,16 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
 def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, area_prev: float | None,
                   probes: dict[str, float] | None, probes_prev: dict[str, float] | None,
                   jump_area: float | None, jump_ratio: float | None,
-                  scales: dict[str, float] | None = None) -> list[str]:
+                  scales: dict[str, float] | None = None, floors: dict[str, float] | None = None) -> list[str]:
     """Warnings for a step in which the debonded fraction of the interface grew by more than
     ``jump_area`` or a probe grew more than ``jump_ratio`` times as fast as the load factor
     (|v/v_prev| > jump_ratio · max(1, |λ/λ_prev|), only where |v_prev| > 0). ``scales``: the
     largest |value| of each probe so far; a probe whose two values are both below 10⁻⁹ of it is
-    round-off (a reaction after complete separation), not a jump."""
+    round-off (a reaction after complete separation), not a jump. ``floors``: the noise floor of
+    each probe, the size below which the solver does not resolve it (a reaction: the Newton
+    tolerance times the run's force scale, see ``runner._probe_floors``); a probe whose two
+    values are both below it is round-off too - e.g. the sum of the reactions that equilibrium
+    makes zero, whose own largest value is round-off as well."""
     out = []
     if jump_area is not None and area is not None and area_prev is not None and area - area_prev > jump_area:
         out.append(f"step {step} (λ = {lam:.6g}): the debonded area jumped from {100 * area_prev:.3g} % to "
@@ -297,6 +301,8 @@ def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, ar
             if v0 is None or not np.isfinite(v) or not np.isfinite(v0) or abs(v0) <= 1e-12 * max(abs(v), 1e-300):
                 continue
             if scales and max(abs(v), abs(v0)) <= 1e-9 * scales.get(k, 0.0):
+                continue
+            if floors and max(abs(v), abs(v0)) <= floors.get(k, 0.0):
                 continue
             if abs(v / v0) > jump_ratio * grow:
                 out.append(f"step {step} (λ = {lam:.6g}): probe '{k}' jumped from {v0:.6g} to {v:.6g} "
@@ -317,13 +323,15 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                on_step_end: Callable[[Problem, np.ndarray, float], bool] | None = None,
                measure: Callable[[Problem], float] | None = None,
                watch: Callable[[np.ndarray, float], dict[str, float]] | None = None,
-               max_resolves: int = 200) -> Iterator[StepResult]:
+               max_resolves: int = 200,
+               floors: Callable[[], dict[str, float]] | None = None) -> Iterator[StepResult]:
     """Converged increments along the equilibrium path (see the module docstring); each
     :class:`StepResult` carries ``state`` (a :class:`PathState`) and ``warnings``. Ends at
     λ = ``lambda_end`` (load control, or arc length on a rising branch: the last increment is a
     load-controlled one to λ_end exactly), when λ falls below ``end_fraction`` of its peak
     (complete failure), or after
-    ``max_steps`` increments."""
+    ``max_steps`` increments. ``watch(u, λ)``: the probe values that the jump check watches;
+    ``floors()``: their noise floors at the current state (:func:`jump_warnings`)."""
     check_path(problem, ps)
     u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
     lam = lam0
@@ -404,7 +412,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
-                                 scales):
+                                 scales, floors() if floors is not None else None):
                     ok, msg = False, "probe jump"
             if ok:
                 break
@@ -448,7 +456,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
-                               probe_scales(scales, probes))
+                               probe_scales(scales, probes), floors() if floors is not None else None)
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)

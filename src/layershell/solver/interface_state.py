@@ -30,6 +30,7 @@ from ..cohesive import (FULL_DAMAGE, CohesiveBlock, CohesiveLaw, cohesive_tracti
 from ..contact import ContactBlock, friction_shape_inverse
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_delam, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
+from ..process_zone import Arm, in_plane_modulus, zone_lengths
 
 
 @dataclass
@@ -63,6 +64,7 @@ class CohesiveRun:
     first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
     initial: np.ndarray  # (e, q) points of initially debonded zones
     first_failure: float | None = None  # first point fully debonded
+    onset_B: float | None = None  # mode ratio B = G_II/G_T of the points that damaged first
 
     def update(self, u: np.ndarray, lam: float) -> None:
         """Commit the converged state: damage, dissipated energies, friction limit of the next step."""
@@ -104,6 +106,8 @@ class CohesiveRun:
         fresh = ~self.initial  # initially debonded zones do not count as new damage
         if np.isnan(self.first_damage) and np.any((d > 0) & fresh):
             self.first_damage = np.array(lam, float)
+            first = (d > 0) & fresh  # the mode of the loading where damage starts (process-zone warning)
+            self.onset_B = float(np.average(B[first], weights=w[first] * d[first]))
         if self.first_failure is None and np.any((d >= FULL_DAMAGE) & fresh):
             self.first_failure = lam
         # --- friction of the next step on the damaged share under compression: the thesis's
@@ -155,7 +159,8 @@ class InterfaceController:
     resolves: int = 0  # re-solutions in the current step
     lam: float = 0.0
     mesh_nodes: np.ndarray | None = None  # for plots
-    warnings: list = field(default_factory=list)  # set-up warnings (cohesive process zone)
+    warnings: list = field(default_factory=list)  # set-up warnings
+    new_warnings: list = field(default_factory=list)  # warnings of the last update (cohesive process zone)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
     f_last: np.ndarray | None = None  # [external force, layers' internal force] there
@@ -191,7 +196,6 @@ class InterfaceController:
                                      np.zeros((ne, nq, 3)), np.zeros((ne, nq), bool), np.full((ne, nq), np.nan),
                                      z.copy(), np.zeros((ne, nq, 3)), z.copy()))
         ctl = cls(runs, settings or DelaminationSettings(), mesh_nodes=model.mesh.nodes)
-        ctl.warnings = [w for r in runs if isinstance(r, CohesiveRun) for w in _process_zone_warning(model, r)]
         problem.extra_blocks = [r.block for r in runs]
         ctl.sync(problem)
         return ctl
@@ -223,7 +227,10 @@ class InterfaceController:
             self._path_energies(problem, u, lam)
         for r in self.runs:
             if isinstance(r, CohesiveRun):
+                started = r.onset_B is None
                 r.update(u, lam)
+                if started and r.onset_B is not None:  # damage started: is its process zone resolved?
+                    self.new_warnings += _process_zone_warning(model, r, r.onset_B)
                 continue
             blk, itf = r.block, r.block.itf
             ne, nq = blk.w.shape
@@ -510,24 +517,73 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
                        np.array(np.nan), d0 > 0)
 
 
-def _process_zone_warning(model, r: CohesiveRun) -> list[str]:
-    """Turon et al. (2007): the cohesive zone l_cz ≈ E G_c / τ0² should span at least 3 node
-    spacings (about 3 elements are usually recommended; here the node spacing of the 9-node
-    elements, half an element)."""
+def _arm(model, k: int, direction: np.ndarray, normal: np.ndarray) -> Arm:
+    """Layer ``k`` as an arm of the process-zone estimate along the unit ``direction`` (in the
+    plane with unit ``normal``): its smallest thickness, in-plane modulus and transverse shear
+    modulus along that direction, E3. A layer held by supports at every node (all directors and
+    components, e.g. a rigid substrate) is rigid."""
+    ly = model.layers[k]
+    mat = ly.material
+    if _held(model, k):
+        return Arm(float(ly.thickness.min()), np.inf, np.inf, np.inf)
+    a1 = np.asarray(ly.direction, float) if ly.direction is not None else np.array([1.0, 0.0, 0.0])
+    a1 = a1 - (a1 @ normal) * normal  # its tangent-plane projection; the material axis 1 is at ω from it
+    theta = float(np.arctan2(np.cross(a1, direction) @ normal, a1 @ direction))
+    E, G = in_plane_modulus(mat, theta - ly.angle)
+    return Arm(float(ly.thickness.min()), E, mat.E3, G)
+
+
+def _held(model, k: int) -> bool:
+    """True where supports fix every director and component of layer ``k`` at all its nodes."""
+    held = np.zeros((model.mesh.n_nodes, model.layers[k].directors + 1, 3), bool)
+    for f in model.fixes:
+        if f.layer == k:
+            dirs = [d for d in f.directors if d <= model.layers[k].directors]
+            held[np.ix_(np.asarray(f.nodes), dirs, list(f.components))] = True
+    stacks = [i for i, st in enumerate(model.stacks) if k in st]
+    nodes = np.unique(model.mesh.elements[np.isin(model.element_stack, stacks)])
+    return bool(nodes.size) and bool(held[nodes].all())
+
+
+def process_zone_estimate(model, r: CohesiveRun) -> tuple[dict, float, np.ndarray]:
+    """The process-zone lengths of a cohesive interface per mode (:mod:`layershell.process_zone`,
+    with its penalty K and the two adjacent layers as arms along the finer mesh direction), the
+    node spacing h along that direction (half the shorter side of the largest elements: the
+    front runs along one side) and that direction."""
     cb = r.block.contact
-    lo, up = model.layers[cb.itf.lower], model.layers[cb.itf.upper]
-    E = min(lo.material.E3, up.material.E3)
-    lcz = r.law.process_zone_length(E)
     X = model.mesh.nodes[cb.conn]  # (e, 9, 3)
-    # node spacing: half the shorter side of the largest elements (the front runs along one side)
-    h = 0.5 * min(float(np.linalg.norm(X[:, 1] - X[:, 0], axis=-1).max()),
-                  float(np.linalg.norm(X[:, 3] - X[:, 0], axis=-1).max()))
+    s1, s3 = X[:, 1] - X[:, 0], X[:, 3] - X[:, 0]
+    n1, n3 = np.linalg.norm(s1, axis=-1), np.linalg.norm(s3, axis=-1)
+    i1, i3 = int(np.argmax(n1)), int(np.argmax(n3))
+    if n1[i1] <= n3[i3]:
+        h, e, i = 0.5 * n1[i1], s1[i1] / n1[i1], i1
+    else:
+        h, e, i = 0.5 * n3[i3], s3[i3] / n3[i3], i3
+    nrm = np.cross(s1[i], s3[i])
+    nrm = nrm / np.linalg.norm(nrm)
+    law = r.law
+    arms = (_arm(model, cb.itf.lower, e, nrm), _arm(model, cb.itf.upper, e, nrm))
+    return zone_lengths(law.G_Ic, law.G_IIc, law.sigma_max, law.tau_max, r.block.K, arms), float(h), e
+
+
+def _process_zone_warning(model, r: CohesiveRun, B: float) -> list[str]:
+    """Turon et al. (2007): the cohesive process zone should span at least 3 node spacings
+    (about 3 elements are usually recommended; here the node spacing of the 9-node elements,
+    half an element). Checked when damage starts, with the mode ratio ``B`` = G_II/G_T of the
+    points that damaged first: the length l = (1 − B) l_I + B l_II of the mode estimates
+    (:func:`process_zone_estimate`)."""
+    est, h, _ = process_zone_estimate(model, r)
+    lI, lII = est["I"]["length"], est["II"]["length"]
+    lcz = (1.0 - B) * lI + B * lII
     if lcz >= 3.0 * h:
         return []
-    return [f"interface '{cb.itf.name}': the cohesive process zone l_cz = E G_c / tau0^2 = {lcz:.4g} "
-            f"(E = {E:.4g}) spans {lcz / h:.2f} node spacings (h = {h:.4g}), fewer than 3: the peak load and the "
-            "debonding load are then mesh dependent (Turon et al. 2007); refine the mesh along the debonding "
-            "front, or check that G_Ic, G_IIc and the strengths are consistent"]
+    name = r.block.contact.itf.name
+    return [f"interface '{name}': damage started (mode ratio G_II/G = {B:.2f}); its process zone, from the "
+            f"onset of damage to complete separation, is estimated at {lcz:.4g} (mode I {lI:.4g}, mode II "
+            f"{lII:.4g}; layershell.process_zone) and spans {lcz / h:.2f} node spacings (h = {h:.4g}), fewer "
+            "than 3: the peak load and the debonding load are then mesh dependent (Turon et al. 2007). Refine "
+            f"the mesh along the debonding front to a node spacing of at most {lcz / 3:.3g} (elements of "
+            f"{2 * lcz / 3:.3g}), or check that G_Ic, G_IIc and the strengths are consistent"]
 
 
 def _default_stick(model, itf: Interface) -> float:

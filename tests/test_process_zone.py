@@ -1,0 +1,232 @@
+"""Issue 13 item 4: the cohesive process-zone estimate (layershell.process_zone) against the
+process zone measured in FE runs, and probes that are round-off (a reaction that equilibrium
+makes zero) kept out of the jump warnings and step cuts."""
+import warnings
+
+import numpy as np
+import pytest
+
+from helpers import run_example
+from layershell.solver.arclength import jump_warnings
+
+# ---------------------------------------------------------------------- round-off probes
+#: examples/dcb_cohesive.toml (force control: the two arms pulled apart by equal and opposite
+#: forces) with the reactions of the clamp as probes: zero by equilibrium, so their values are
+#: solver round-off (~1e-13 N against loads of 10-60 N)
+ROUND_OFF = {
+    "nonlinear = false": "nonlinear = true",  # Newton iterates: the round-off changes from step to step
+    "nx = 150": "nx = 20",
+    '[[probes]]\nname = "P"': '[[probes]]\nname = "Rx"\nquantity = "reaction"\nwhere = "near(x, 150)"\ncomponent = "x"\n\n'
+    '[[probes]]\nname = "Rz"\nquantity = "reaction"\nwhere = "near(x, 150)"\ncomponent = "z"\n\n[[probes]]\nname = "P"',
+}
+
+
+def _probe_jumps(caught) -> list[str]:
+    from layershell.runner import JumpWarning
+
+    return [str(w.message) for w in caught if issubclass(w.category, JumpWarning) and "probe" in str(w.message)]
+
+
+@pytest.mark.parametrize("steps", ["fixed", "adaptive"])
+def test_reactions_that_equilibrium_makes_zero_are_no_jump(steps):
+    """The clamp reactions of the self-equilibrated DCB are round-off whose ratio from step to
+    step is arbitrary (measured: 2.8e-14 → -4.5e-13 N, 16× while λ doubled). Without a noise
+    floor that is a 'jump' (three warnings on the fixed steps; on adaptive steps a cut and a
+    warning). With the floor |scale| ‖ρ‖ tol_residual force_scale (runner._ProbeFloors): none.
+    The check that the floor is needed: the recorded values give jump warnings when the floor
+    is left out."""
+    if steps == "fixed":
+        repl = {**ROUND_OFF, "factors = [0.01, 0.02, 0.05,": "factors = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6] #"}
+    else:
+        repl = {**ROUND_OFF, "factors = [0.01, 0.02, 0.05,": "n = 6\nadaptive = true\nlambda_end = 0.6 #"}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        r = run_example("dcb_cohesive", repl)
+    assert r.converged and r.summary["steps"][-1]["load_factor"] == pytest.approx(0.6)
+    assert not _probe_jumps(caught), _probe_jumps(caught)
+    assert not [w for w in r.summary.get("warnings", []) if "probe" in w]
+    st = r.summary["steps"]
+    assert sum(s["bisections"] for s in st) == 0  # no step cut for round-off
+    P = np.array([s["probes"]["P"] for s in st])
+    R = np.array([[s["probes"]["Rx"], s["probes"]["Rz"]] for s in st])
+    assert np.abs(R).max() < 1e-10 * P.max()  # round-off indeed
+    # the same values without the floor: jumps (the largest |value| so far is round-off too)
+    scales = {k: np.abs(R[:, i]).max() for i, k in enumerate(("Rx", "Rz"))}
+    lams = [s["load_factor"] for s in st]
+    raw = [m for i in range(1, len(st)) for m in jump_warnings(
+        i, lams[i], lams[i - 1], None, None, st[i]["probes"], st[i - 1]["probes"], None, 3.0, scales)]
+    assert raw and all("'Rx'" in m or "'Rz'" in m for m in raw)
+
+
+def test_noise_floor_unit():
+    """A probe whose two values are below its floor is no jump; above it the ratio counts."""
+    assert jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-9}, {"R": 1e-10}, None, 3.0)
+    assert not jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-9}, {"R": 1e-10}, None, 3.0, None, {"R": 1e-8})
+    assert jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-7}, {"R": 1e-10}, None, 3.0, None, {"R": 1e-8})
+    assert jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-9, "w": 5.0}, {"R": 1e-10, "w": 1.0}, None, 3.0, None,
+                         {"R": 1e-8})  # other probes are unaffected
+
+
+# ---------------------------------------------------------------------- process-zone length
+from layershell.cohesive import FULL_DAMAGE  # noqa: E402
+from layershell.io.build import build, parse  # noqa: E402
+from layershell.process_zone import zone_lengths  # noqa: E402
+from layershell.solver.arclength import path_steps  # noqa: E402
+from layershell.solver.interface_state import process_zone_estimate  # noqa: E402
+from layershell.solver.problem import Problem  # noqa: E402
+
+
+def measured_zone(name: str, replace: dict[str, str], sign: float, start: float, stop: float):
+    """The process zone of an FE run of ``examples/<name>.toml`` (text replacements as
+    helpers.run_example): after every converged state, along the leading row of interface
+    points (the front is curved across the width: the edges lag), the distance between the
+    farthest point with damage d > 0 and the farthest point with d ≥ FULL_DAMAGE (the crack
+    tip), the crack growing along s = ``sign`` · x. The states whose crack tip s lies between
+    ``start`` and ``stop`` (steady propagation, away from the initial crack and the ends) count:
+    their mean zone length, the node spacing of the row, the model and its cohesive run."""
+    from helpers import EXAMPLES
+
+    text = (EXAMPLES / f"{name}.toml").read_text()
+    for a, b in replace.items():
+        assert a in text, a
+        text = text.replace(a, b)
+    spec = build(parse(text, name), EXAMPLES)
+    pb = Problem.build(spec.model)
+    ctl = pb.interfaces
+    run_, = ctl.runs
+    blk = run_.block
+    X, Y = sign * blk.contact.X0[..., 0], np.round(blk.contact.X0[..., 1], 9)
+    init = blk.d_old >= FULL_DAMAGE
+    lengths = []
+    for st in path_steps(pb, spec.newton, spec.path_following, on_step_end=lambda p, u, lam: ctl.update(p, u, lam)):
+        d = blk.d_old
+        rows = []
+        for y in np.unique(Y):
+            on = Y == y
+            full, dam = on & (d >= FULL_DAMAGE), on & (d > 0) & ~init
+            if full.any() and dam.any():
+                rows.append((X[full].max(), X[dam].max()))
+        if not rows:
+            continue
+        tip, onset = max(rows)
+        if start <= tip <= stop:
+            lengths.append(onset - tip)
+        if tip > stop:
+            break
+    xs = np.unique(np.round(X[Y == Y.min()], 9))
+    return float(np.mean(lengths)), float(np.diff(xs).min()), len(lengths), spec.model, run_
+
+
+def test_lapshear_process_zone_against_the_bond_slip_closed_form():
+    """Mode II, a strip on a rigid substrate (examples/lapshear_cohesive.toml: CFRP 1.2 mm on
+    concrete held rigid, bilinear bond-slip law of Lu et al. 2005). Closed form (Yuan et al. 2004,
+    layershell.analytic.bond_slip): in steady debonding the softening zone of a long bond has
+    tan(λ₂ l) = sqrt((δ_f − δ₁)/δ₁), l = 93.2 mm. The FE run (arc length through the snap-back,
+    10 mm elements) measures 90-95 mm while the front runs from 245 to 195 mm; the estimate
+    (layershell.process_zone, the rigid substrate recognised from its supports) is 92.8 mm.
+    The thick-body formula E3 G_c/τ0² of the earlier warning says 155 mm (with the smaller,
+    mode-I ratio) - 67 % too long."""
+    from layershell.analytic.bond_slip import BondedJoint
+
+    l_fe, spacing, n, model, r = measured_zone("lapshear_cohesive", {}, -1.0, -245.0, -195.0)
+    law = r.law
+    joint = BondedJoint(E_p=165000.0, t_p=1.2, b_p=50.0, tau_f=law.tau_max, delta_1=law.tau_max / law.K0,
+                        delta_f=2 * law.G_IIc / law.tau_max)
+    l_cf = np.arctan(np.sqrt((joint.delta_f - joint.delta_1) / joint.delta_1)) / joint.lambda_2
+    assert n >= 5
+    assert l_cf == pytest.approx(93.2, rel=2e-3)
+    assert l_fe == pytest.approx(l_cf, abs=spacing)  # the FE zone, to one node spacing
+    est, h, _ = process_zone_estimate(model, r)
+    assert est["II"]["length"] == pytest.approx(l_fe, rel=0.1)
+    assert est["II"]["length"] == pytest.approx(l_cf, rel=0.01)
+    old = law.process_zone_length(10000.0)
+    assert old / l_fe > 1.5
+
+
+#: examples/dcb_cohesive.toml under displacement control (tests/test_dcb.py), shortened to 80 mm
+#: (the clamp 25 mm ahead of the initial crack: far beyond the ~1 mm decay length of the
+#: bonded arms) so that 320 elements give a node spacing of 0.125 mm
+def _dcb_short(nx: int) -> dict[str, str]:
+    from test_dcb import DISPLACEMENT_CONTROL
+
+    return {**DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}", "lx = 150.0": "lx = 80.0",
+            'where = "near(x, 150)"': 'where = "near(x, 80)"',
+            "factors = [0.01, 0.02, 0.05,": "n = 100\nadaptive = true\nincrement_max = 0.02 #"}
+
+
+@pytest.mark.slow
+def test_dcb_process_zone_against_fe():
+    """Mode I, slender arms (DCB, h = 1.98 mm, E11 = 150 GPa, σ_max = 30 MPa, G_Ic = 0.352 N/mm).
+    The FE zone along the leading row while the crack runs from 56 to 57.5 mm, node spacing
+    0.125 mm: measured 1.4-1.5 mm (on 0.5 / 0.25 mm spacings 1.0 / 1.25 mm: it grows slightly
+    with refinement). Estimate (beam on a softening foundation, layershell.process_zone): 1.84 mm,
+    within 35 %. The earlier E3 G_Ic/σ0² = 4.30 mm is 3× too long (a zone it said spans 8.6 node
+    spacings of the 150-element mesh spans 2-3)."""
+    l_fe, spacing, n, model, r = measured_zone("dcb_cohesive", _dcb_short(320), 1.0, 56.0, 57.5)
+    assert n >= 4 and spacing == pytest.approx(0.125)
+    est, h, _ = process_zone_estimate(model, r)
+    assert est["I"]["length"] == pytest.approx(1.84, rel=0.01)
+    assert abs(est["I"]["length"] / l_fe - 1) < 0.35
+    assert r.law.process_zone_length(11000.0) / l_fe > 2.5
+
+
+@pytest.mark.slow
+def test_enf_process_zone_against_fe():
+    """Mode II, the ENF (same arms, τ_max = 101 MPa, G_IIc = 1.002 N/mm), 200 elements (node
+    spacing 0.25 mm): the zone along the leading row while the crack runs from 37 to 40 mm is
+    measured 1.75-2 mm. (The 5-6 mm quoted before were the spread of the partly damaged points
+    across the width: the front is curved, its edges lag the middle by ~5 mm.) Estimate: the
+    arms' shear compliance leaves no softening branch to the slender (shear-lag) estimate, and
+    the thick-body E3 G_IIc/τ0² = 1.08 mm applies: 40 % short - the zone is as long as the arms
+    are thick, between the two limits. The bound asserted: within -50 % / +35 %."""
+    l_fe, spacing, n, model, r = measured_zone("enf_cohesive", {"nx = 100": "nx = 200"}, 1.0, 37.0, 40.0)
+    assert n >= 4 and spacing == pytest.approx(0.25)
+    est, h, _ = process_zone_estimate(model, r)
+    assert 0.5 < est["II"]["length"] / l_fe < 1.35
+
+
+def test_mode_i_slender_limit_scaling():
+    """The slender mode-I estimate follows the Yang & Cox (2005) / Harper & Hallett (2008) scaling
+    (E G_Ic/σ0²)^(1/4) h^(3/4) where the penalty is stiff and the layers' own compliance small
+    (r = (δf − δ0)/δ0 → ∞): doubling h multiplies it by 2^(3/4), and G_Ic by 16 by 2 (x(r) is
+    converged at r ~ 1e9 to 1 %); the mode-II estimate scales as (E G_IIc/τ0²)^(1/2) h^(1/2)."""
+    from layershell.process_zone import Arm
+
+    def lengths(h, G):
+        arms = (Arm(h, 1e5, 1e12, 1e12), Arm(h, 1e5, 1e12, 1e12))
+        z = zone_lengths(G, G, 10.0, 10.0, 1e12, arms)
+        return z["I"]["slender"], z["II"]["slender"]
+
+    I1, II1 = lengths(1.0, 0.1)
+    I2, II2 = lengths(2.0, 0.1)
+    I3, II3 = lengths(1.0, 1.6)
+    assert I2 / I1 == pytest.approx(2 ** 0.75, rel=0.02) and I3 / I1 == pytest.approx(2.0, rel=0.02)
+    assert II2 / II1 == pytest.approx(2 ** 0.5, rel=1e-3) and II3 / II1 == pytest.approx(4.0, rel=1e-3)
+    # mode II, rigid-plastic onset: l = π/(2λ), λ² = c τ0/δf, c = 8/(E h) for two equal arms
+    assert II1 == pytest.approx(np.pi / 2 / np.sqrt(8 / 1e5 * 10.0 / 0.02), rel=1e-3)
+
+
+def test_modulus_along_the_crack_direction():
+    """The arms' modulus is the in-plane modulus along the finer mesh direction (where the front
+    runs): E1 along the fibres, E2 across them (the DCB with `direction = [0, 1, 0]` has a mode-I
+    zone (11/150)^(1/4) as long: c_I = Σ 12/(E h³) changes, the foundation does not), the
+    transverse shear modulus
+    G31 → G23; an isotropic layer has E in every direction."""
+    from layershell.material import Orthotropic
+    from layershell.process_zone import in_plane_modulus
+
+    m = Orthotropic(150000.0, 11000.0, 11000.0, 6000.0, 3700.0, 6000.0, 0.25, 0.45, 0.0183)
+    assert in_plane_modulus(m, 0.0) == pytest.approx((150000.0, 6000.0))
+    assert in_plane_modulus(m, np.pi / 2) == pytest.approx((11000.0, 3700.0))
+    iso = Orthotropic.isotropic(30000.0, 0.2)
+    assert in_plane_modulus(iso, 0.7)[0] == pytest.approx(30000.0)
+    from helpers import EXAMPLES
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text()
+    ests = []
+    for t in (text, text.replace("direction = [1, 0, 0]", "direction = [0, 1, 0]")):
+        spec = build(parse(t, "dcb"), EXAMPLES)
+        est, h, e = process_zone_estimate(spec.model, Problem.build(spec.model).interfaces.runs[0])
+        assert e == pytest.approx([1.0, 0.0, 0.0]) and h == pytest.approx(0.5)
+        ests.append(est["I"]["slender"])
+    assert ests[1] / ests[0] == pytest.approx((11 / 150) ** 0.25, rel=1e-9)
