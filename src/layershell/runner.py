@@ -120,6 +120,9 @@ def _version() -> str:
     return __version__
 
 
+FRESH_SOLVERS_EACH_STEP = False
+
+
 def _fresh_linear_solvers(problem: Problem) -> None:
     """Begin the next load step with new linear solvers, as a restarted run does. PARDISO's
     pivoting (matching, scaling) follows the matrix of its symbolic analysis, so a solver kept
@@ -544,7 +547,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                         f"{st.bisections} bisection(s), {st.wall_seconds:.3f} s"
                         + (f", debonded area {debonded_total():.6g}" if ctl is not None else ""))
                 live["step"] = st.step + 1
-            _fresh_linear_solvers(problem)
+            if FRESH_SOLVERS_EACH_STEP:
+                _fresh_linear_solvers(problem)
             if progress is not None:
                 progress(st.step, n_steps, st.load_factor)
         summary["converged"] = True

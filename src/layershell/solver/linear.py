@@ -293,6 +293,18 @@ class PardisoGeneral(PardisoSymmetric):
 
     MTYPE = 11
 
+    def _init_parameters(self) -> None:
+        """As for the symmetric matrix, and without the scaling and weighted matching that
+        ``pardisoinit`` switches on for unsymmetric matrices (iparm[10], iparm[12]): they are
+        computed from the values of the matrix in the symbolic analysis, so that the
+        factorisations of later matrices would depend on which matrix was analysed - a run
+        restarted from a checkpoint would differ from the uninterrupted one. Without them the
+        analysis depends on the pattern alone, as in the symmetric mode, and can be kept from
+        step to step (pivots are perturbed, then refined, where they are small: iparm[9])."""
+        super()._init_parameters()
+        self._s.iparm[10] = 0
+        self._s.iparm[12] = 0
+
     def matrix(self, K: sp.spmatrix) -> sp.csr_matrix:
         A = sp.csr_matrix(K, copy=True)
         A.sort_indices()
