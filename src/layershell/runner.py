@@ -120,19 +120,6 @@ def _version() -> str:
     return __version__
 
 
-FRESH_SOLVERS_EACH_STEP = False
-
-
-def _fresh_linear_solvers(problem: Problem) -> None:
-    """Begin the next load step with new linear solvers, as a restarted run does. PARDISO's
-    pivoting (matching, scaling) follows the matrix of its symbolic analysis, so a solver kept
-    across steps would make a restarted run differ from an uninterrupted one in the last digits
-    and in the iteration counts. Costs one symbolic analysis per load step."""
-    for solver in getattr(problem, "solvers", {}).values():
-        solver.release()
-    getattr(problem, "solvers", {}).clear()
-
-
 def _zone_arrays(zones) -> dict[str, np.ndarray]:
     """The recorded zone-map history as arrays for the checkpoint."""
     if not zones.steps:
@@ -547,8 +534,6 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                         f"{st.bisections} bisection(s), {st.wall_seconds:.3f} s"
                         + (f", debonded area {debonded_total():.6g}" if ctl is not None else ""))
                 live["step"] = st.step + 1
-            if FRESH_SOLVERS_EACH_STEP:
-                _fresh_linear_solvers(problem)
             if progress is not None:
                 progress(st.step, n_steps, st.load_factor)
         summary["converged"] = True
