@@ -59,9 +59,13 @@ def _run_and_signal(model: Path, out: Path, after_step: int, sig: int, extra=())
     ``after_step`` is on disk. Returns (process, checkpoint step when signalled, stderr)."""
     env = dict(os.environ, NO_COLOR="1", COLUMNS="200", PYTHONIOENCODING="utf-8")
     env.pop("LAYERSHELL_TRACEBACK", None)
+    # the run at a lower priority: on a busy machine the polling below must not fall behind the
+    # run's steps (the tiny model finishes its remaining steps in a fraction of a second; a poll
+    # that comes too late finds the run done and the signal has nothing to interrupt)
+    nice = (lambda: os.nice(15)) if hasattr(os, "nice") else None
     p = subprocess.Popen(_command() + ["run", str(model), "--out", str(out), "--quiet", *extra],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, encoding="utf-8", env=env,
-                         cwd=model.parent)
+                         cwd=model.parent, preexec_fn=nice)
     seen = 0
     deadline = time.monotonic() + 300
     while p.poll() is None and time.monotonic() < deadline:
