@@ -56,25 +56,34 @@ def _checkpoint_step(folder: Path) -> int:
 
 def _run_and_signal(model: Path, out: Path, after_step: int, sig: int, extra=()) -> tuple[subprocess.Popen, int, str]:
     """Start ``layershell run`` in a subprocess and send ``sig`` once the checkpoint of
-    ``after_step`` is on disk. Returns (process, checkpoint step when signalled, stderr)."""
+    ``after_step`` is on disk. Returns (process, checkpoint step when signalled, stderr).
+
+    On a busy machine the polling can fall behind the tiny model, whose remaining steps take a
+    fraction of a second: the run is then over (or at its last step) before the signal is sent,
+    and the attempt says nothing about the signal handling. Such an attempt is repeated (at most
+    3 times, the run at a lower priority); a run that ignores a signal sent in time still fails
+    the caller's checks."""
     env = dict(os.environ, NO_COLOR="1", COLUMNS="200", PYTHONIOENCODING="utf-8")
     env.pop("LAYERSHELL_TRACEBACK", None)
-    # the run at a lower priority: on a busy machine the polling below must not fall behind the
-    # run's steps (the tiny model finishes its remaining steps in a fraction of a second; a poll
-    # that comes too late finds the run done and the signal has nothing to interrupt)
     nice = (lambda: os.nice(15)) if hasattr(os, "nice") else None
-    p = subprocess.Popen(_command() + ["run", str(model), "--out", str(out), "--quiet", *extra],
-                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, encoding="utf-8", env=env,
-                         cwd=model.parent, preexec_fn=nice)
-    seen = 0
-    deadline = time.monotonic() + 300
-    while p.poll() is None and time.monotonic() < deadline:
-        seen = _checkpoint_step(out)
-        if seen >= after_step:
-            p.send_signal(sig)
+    for attempt in range(3):
+        if out.exists():
+            shutil.rmtree(out)
+        p = subprocess.Popen(_command() + ["run", str(model), "--out", str(out), "--quiet", *extra],
+                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, encoding="utf-8", env=env,
+                             cwd=model.parent, preexec_fn=nice)
+        seen, sent = 0, False
+        deadline = time.monotonic() + 300
+        while p.poll() is None and time.monotonic() < deadline:
+            seen = _checkpoint_step(out)
+            if seen >= after_step:
+                p.send_signal(sig)
+                sent = True
+                break
+            time.sleep(0.005)
+        _, stderr = p.communicate(timeout=300)
+        if sent and seen < N_STEPS:
             break
-        time.sleep(0.005)
-    _, stderr = p.communicate(timeout=300)
     return p, seen, stderr
 
 
