@@ -81,9 +81,11 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
 
     Cohesive interfaces (blocks with ``smooth_when_frozen``): no semi-smooth phase (it cycles at
     the kink of the law at the onset of damage); the active-set loop freezes the tension state
-    and the loading set, iterates with full Newton steps on the then smooth problem, and a set
-    that has not settled after ``max_active_set_loops`` is a failure (the step is cut), not an
-    accepted state."""
+    and the loading set, iterates with full Newton steps on the then smooth problem (repeated
+    with the residual line search where that fails while friction acts on the damaged share),
+    and a set that has not settled after ``max_active_set_loops``, or cycles, is a failure (the
+    step is cut) - unless a converged state of the loop violates the damage law by less than the
+    consistency tolerance (:class:`ActiveSetLoop`), which is then accepted and counted."""
     u = problem.impose(u, lam)  # prescribed displacements at this load factor (displacement control)
     blocks, cohesive_only = active_set_blocks(problem)
     if not blocks:
