@@ -5,8 +5,9 @@ a run killed with SIGKILL (or stopped with SIGINT) after a few steps and resumed
 ``layershell run --restart`` must reach the same final state to 1e-10: displacements, bond
 flags and every interface history array (g_T^max, slip, friction state), the probes and the
 summary. The model is the thesis §5.1 plate with slip-softening friction, reduced to 1 × 2
-elements and d = 1 so that it runs in seconds; it debonds at step 3 of 6, so the restart after
-step 2 or 3 has to carry (or rebuild) a non-trivial interface state.
+elements and d = 1 so that it runs in seconds; it debonds at step 6 of 12 (λ = 0.75), so the restart after
+step 2 (before) or 6 (after the debonding) has to carry (or rebuild) a non-trivial interface
+state.
 """
 from __future__ import annotations
 
@@ -29,7 +30,8 @@ from layershell.io.build import load
 from layershell.runner import run
 
 ROOT = Path(__file__).resolve().parents[1]
-N_STEPS = 6
+N_STEPS = 12  # of 0.125: the signal tests send theirs after step 2 or 6, with the later steps as slack
+DEBOND_STEP = 6  # λ = 0.75: the step in which the tiny model debonds
 
 
 def _tiny_text(**extra: str) -> str:
@@ -140,14 +142,14 @@ def tiny(tmp_path_factory) -> Path:
 
 
 def test_killed_run_resumes_to_the_same_result(tiny, tmp_path):
-    """SIGKILL after step 3 (the step that debonds), then ``--restart``: same result to 1e-10."""
+    """SIGKILL after step 6 (the step that debonds), then ``--restart``: same result to 1e-10."""
     part = tmp_path / "part"
-    p, seen, stderr = _run_and_signal(tiny, part, 3, signal.SIGKILL, ["--no-vtu"])
+    p, seen, stderr = _run_and_signal(tiny, part, DEBOND_STEP, signal.SIGKILL, ["--no-vtu"])
     assert p.returncode == -signal.SIGKILL, stderr
     done = json.loads((part / "summary.json").read_text(encoding="utf-8"))
     assert not done["converged"]
     k = _checkpoint_step(part)
-    assert 3 <= k < N_STEPS
+    assert DEBOND_STEP <= k < N_STEPS
     # the step's lines are appended first, then the checkpoint: steps.jsonl and probes.csv hold k or k + 1
     # steps; summary.json (the whole history, rewritten at a bounded rate) may lag behind
     n_lines = len((part / "steps.jsonl").read_text(encoding="utf-8").splitlines())
@@ -156,7 +158,7 @@ def test_killed_run_resumes_to_the_same_result(tiny, tmp_path):
     r = _cli(["run", str(tiny), "--restart", str(part), "--no-vtu", "--quiet"], tmp_path)
     assert r.exit_code == 0, r.output
     s = json.loads((part / "summary.json").read_text(encoding="utf-8"))
-    assert s["restarts"] == [{"step": _restart_step(s), "load_factor": pytest.approx(_restart_step(s) * 0.25)}]
+    assert s["restarts"] == [{"step": _restart_step(s), "load_factor": pytest.approx(_restart_step(s) * 1.5 / N_STEPS)}]
     _assert_same_state(tiny.parent / "full", part)
 
 
@@ -213,17 +215,17 @@ def test_sigterm_ends_like_ctrl_c(tiny, tmp_path):
 
 
 def test_restart_needs_the_saved_interface_state(tiny, tmp_path):
-    """Control for the comparisons above: from the same step-3 checkpoint, the in-process restart
+    """Control for the comparisons above: from the same checkpoint of the debonding step, the in-process restart
     with the saved interface state reproduces the uninterrupted run to 1e-10, while the same
     restart with the interface state reset (all bonded, no history) ends clearly elsewhere; so
     the agreement is due to the restored state, not to a state that does not matter."""
     spec = load(tiny)
     spec3 = load(tiny)
-    spec3.load_factors = spec.load_factors[:3]
+    spec3.load_factors = spec.load_factors[:DEBOND_STEP]
     assert run(spec3, tmp_path / "three", write_vtu=False).converged
     ck3 = checkpoint.load(tmp_path / "three")
-    assert ck3.step == 3 and not ck3.interface_state["bonded.1"].all()
-    ck3.load_factors = spec.load_factors  # continue to step 6 (the hash does not include the factors)
+    assert ck3.step == DEBOND_STEP and not ck3.interface_state["bonded.1"].all()
+    ck3.load_factors = spec.load_factors  # continue to the last step (the hash does not include the factors)
     full = checkpoint.load(tiny.parent / "full")
     finals = {}
     for name in ("saved", "reset"):
@@ -239,7 +241,7 @@ def test_restart_needs_the_saved_interface_state(tiny, tmp_path):
         checkpoint.save(folder / checkpoint.FILENAME, ck3)
         shutil.copy(tmp_path / "three" / "steps.jsonl", folder)  # the step records belong to the restart point
         r = run(load(tiny), folder, write_vtu=False, restart=folder)
-        assert r.converged and r.summary["restarts"][0]["step"] == 3
+        assert r.converged and r.summary["restarts"][0]["step"] == DEBOND_STEP
         finals[name] = np.abs(r.u - full.u).max() / np.abs(full.u).max()
     assert finals["saved"] < 1e-10, finals
     assert finals["reset"] > 1e-4, finals
