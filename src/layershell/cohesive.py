@@ -365,17 +365,18 @@ class CohesiveBlock:
     CONSISTENCY_TOL = 1e-3
 
     def _trial(self, u_full: np.ndarray):
-        """Normal gap, trial damage (smooth continuation below the onset) at ``u_full``."""
+        """Normal gap, trial damage (smooth continuation below the onset), equivalent separation
+        λ and mode ratio B at ``u_full``."""
         delta = self.separation(u_full)
         n = self.contact.A3
         _, _, lam, B, _, _ = separation_measures(delta, n)
         dt, _, _ = damage_trial(lam, B, self.K, self.law, extend=True)
-        return np.einsum("eqi,eqi->eq", delta, n), dt
+        return np.einsum("eqi,eqi->eq", delta, n), dt, lam, B
 
     def actual_sets(self, u_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(tension, loading) of every point at ``u_full``: δ_n >= 0, and the points whose damage
         grows (trial damage, continued below the onset, above the history)."""
-        return self._sets(*self._trial(u_full))
+        return self._sets(*self._trial(u_full)[:2])
 
     def _sets(self, g: np.ndarray, dt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         loading = (dt > self.d_old - self.LOADING_TOL) & (dt > 0.0) & (self.d_old < FULL_DAMAGE)
@@ -398,7 +399,7 @@ class CohesiveBlock:
         node, all points of the front loading unloads two of them, and without those they load
         again - while a set in between is (the standard remedy for a cycling primal-dual active
         set, cf. Hintermüller, Ito & Kunisch 2002)."""
-        g, dt = self._trial(u_full)
+        g, dt, _, _ = self._trial(u_full)
         tension, loading = self._sets(g, dt)
         if limited and self.frozen is not None and self.frozen[1] is not None:
             prev = self.frozen[1]
@@ -422,16 +423,12 @@ class CohesiveBlock:
         damage fell below its history or a point outside the set whose trial damage exceeds it,
         K d |δ_n| for a damaged point whose tension state changed; 0 where the sets hold
         (:data:`LOADING_TOL` on the damage). The active-set loop accepts a cycling set whose
-        violation is below :data:`CONSISTENCY_TOL` (:func:`~layershell.solver.newton.
-        active_set_loop`)."""
+        violation is below :data:`CONSISTENCY_TOL` (:class:`~layershell.solver.newton.
+        ActiveSetLoop`)."""
         if self.frozen is None:
             return 0.0
         tension_f, loading_f = self.frozen
-        delta = self.separation(u_full)
-        n = self.contact.A3
-        _, _, lam, B, _, _ = separation_measures(delta, n)
-        dt, _, _ = damage_trial(lam, B, self.K, self.law, extend=True)
-        g = np.einsum("eqi,eqi->eq", delta, n)
+        g, dt, lam, B = self._trial(u_full)
         tol = self.LOADING_TOL
         d_held = np.where(loading_f, dt, self.d_old)
         tension_changed = ((g >= 0) != tension_f) & (d_held > 0)
@@ -539,6 +536,5 @@ class CohesiveBlock:
     def elastic_energy(self, u_full: np.ndarray) -> float:
         """Stored energy of the cohesive springs ½K|δ|² - ½dK|<δ_n>n + δ_s|² integrated."""
         delta, _, d, _ = self.point_state(u_full)
-        dn, ds, lam, _, _, _ = separation_measures(delta, self.contact.A3)
-        psi = 0.5 * self.K * np.einsum("eqi,eqi->eq", delta, delta) - 0.5 * d * self.K * lam**2
+        _, psi = cohesive_traction_energy(delta, self.contact.A3, d, self.K)
         return float((self.contact.w * psi).sum())

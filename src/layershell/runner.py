@@ -140,7 +140,8 @@ def _restore_zones(zones, extra: dict[str, np.ndarray]) -> None:
     zones.released = [[extra[f"zones.released.{i}"][j].copy() for i in range(n_itf)] for j in range(len(zones.steps))]
 
 
-def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck, on_step_end):
+def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck, on_step_end,
+                floors: "_ProbeFloors"):
     """The converged increments of arc-length or adaptive load control, continued from the
     checkpoint's path state (arc length, constraint, last increment) after a restart."""
     from .solver.arclength import PathState, path_steps
@@ -154,7 +155,7 @@ def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck,
     return path_steps(problem, spec.newton, spec.path_following, u0=u, lam0=lam0, step0=step0, state=state,
                       on_step_end=on_step_end, measure=(lambda pb: pb.interfaces.debonded_fraction())
                       if ctl is not None else None, watch=watch if spec.probes else None,
-                      floors=_ProbeFloors(spec, problem))
+                      floors=floors)
 
 
 class _ProbeFloors:
@@ -353,12 +354,6 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     if ctl is not None and ctl.energies(problem, np.zeros(problem.dm.n_full)) is not None else [])
     if energy_names:
         summary.update(first_damage_load_factor=None, peak_load_factor=None, energy=None)
-        if ctl.warnings:  # set-up warnings of the interfaces: console and summary.json
-            import warnings as _w
-
-            summary.setdefault("warnings", []).extend(ctl.warnings)
-            for m in ctl.warnings:
-                _w.warn(m, CohesiveWarning, stacklevel=2)
     from .plots import ZoneHistory
 
     zones = ZoneHistory(ctl, keep=spec.output.zone_steps)  # debonded flags of the steps the zone maps may show
@@ -470,9 +465,10 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         steps = (load_steps(problem, spec.load_factors[step0:], spec.newton, u0=u, lam0=lam0, step0=step0,
                             on_step_end=on_step_end if ctl is not None else None, cut=cut)
                  if step0 < n_steps else ())
+        floors = _ProbeFloors(spec, problem)  # noise floors of the reaction probes (the jump check)
         if spec.path_following is not None:  # arc length / adaptive steps (solver/arclength.py)
-            steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None)
-        jumps = _JumpWatch(spec, summary, ctl, _ProbeFloors(spec, problem))
+            steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None, floors)
+        jumps = _JumpWatch(spec, summary, ctl, floors)
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u

@@ -286,7 +286,7 @@ def jump_warnings(step: int, lam: float, lam_prev: float, area: float | None, ar
     largest |value| of each probe so far; a probe whose two values are both below 10⁻⁹ of it is
     round-off (a reaction after complete separation), not a jump. ``floors``: the noise floor of
     each probe, the size below which the solver does not resolve it (a reaction: the Newton
-    tolerance times the run's force scale, see ``runner._probe_floors``); a probe whose two
+    tolerance times the run's force scale, see ``runner._ProbeFloors``); a probe whose two
     values are both below it is round-off too - e.g. the sum of the reactions that equilibrium
     makes zero, whose own largest value is round-off as well."""
     out = []

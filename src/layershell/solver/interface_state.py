@@ -159,7 +159,6 @@ class InterfaceController:
     resolves: int = 0  # re-solutions in the current step
     lam: float = 0.0
     mesh_nodes: np.ndarray | None = None  # for plots
-    warnings: list = field(default_factory=list)  # set-up warnings
     new_warnings: list = field(default_factory=list)  # warnings of the last update (cohesive process zone)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)

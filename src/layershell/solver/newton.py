@@ -133,7 +133,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         total.iterations += res.iterations
         total.residuals += res.residuals
         left -= res.iterations
-        if not res.converged and s_frozen is not s and s.line_search and left > 0 and _friction_acts(blocks):
+        if not res.converged and cohesive_only and s.line_search and left > 0 and _friction_acts(blocks):
             # friction on the damaged share (stick/slip) is not smooth within the frozen sets:
             # full steps can wander there (the §5.1 cohesive plate past its first full debonding
             # stopped at λ = 1.074 on 12 × 12, with the residual line search it reaches 1.2);
