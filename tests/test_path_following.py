@@ -417,3 +417,20 @@ def test_displacement_control_restart(tmp_path):
     assert again.converged and full.converged
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
     assert again.summary["probes"]["w"] == pytest.approx(3.0, rel=1e-12)
+
+
+def test_stagnation_detects_stalled_and_cycling_newton_only():
+    """`stagnates` (arc-length increments with frozen cohesive sets give up on it): a stalled
+    residual (the DCB's frozen loading point that ping-pongs across δ_n = 0: 2566 N in every
+    iteration) and a two-cycle are detected after n iterations without progress; quadratic
+    convergence, and convergence after a few iterations of growth, are not."""
+    from layershell.solver.newton import stagnates
+
+    def first(res, n=3):  # the first iteration at which the check fires, or None
+        return next((k for k in range(len(res) + 1) if stagnates(res[:k], n)), None)
+
+    assert first([3.2e3, 1.5e3, 1.0e4, 2566.0, 2566.0, 2566.0, 2566.0, 2566.0]) == 5
+    assert first([8.4e3, 2.8e3, 8.6e3, 9.7e3, 1.9e4, 1.87e3, 2.15e4, 1.87e3, 2.15e4, 1.87e3, 2.15e4]) == 5
+    assert first([1e3, 3e2, 2e1, 1e-1, 1e-5, 1e-12]) is None
+    assert first([1.0, 5.0, 3.0, 0.5, 1e-3, 1e-8]) is None  # grows first, then converges
+    assert first([2566.0] * 10, 0) is None  # off

@@ -35,7 +35,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, newton
+from .newton import ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, newton, stagnates
 from .problem import Problem
 
 
@@ -185,7 +185,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             return _unfrozen(att, blocks, loop, problem)
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
-                                                min(s.max_iterations, left))
+                                                min(s.max_iterations, left),
+                                                s.stagnation_iterations if blocks else 0)
         if not ok:
             return _unfrozen(att, blocks, loop, problem)
         if loop.consistent(att.u, (att.u, att.lam)):
@@ -211,10 +212,11 @@ def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, pro
 
 def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
-                            max_iterations: int) -> tuple[np.ndarray, float, bool]:
+                            max_iterations: int, stagnation: int = 0) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
-    it converged."""
+    it converged. ``stagnation``: give up after that many iterations in a row without progress
+    (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets)."""
     op, asm = problem.op, problem.assembler
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
@@ -238,6 +240,9 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             return dur, dlam, True
         if it == max_iterations:
             break
+        if stagnates(att.residuals[len(att.residuals) - it - 1:], stagnation):
+            att.message = f"no progress in the last {stagnation} of {it} iterations (residual {rn:.3e})"
+            return dur, dlam, False
         try:
             _, Kr = asm.evaluate_reduced(u, op)
             ab = solver.solve(Kr, np.column_stack([r, q]))

@@ -37,6 +37,14 @@ class NewtonSettings:
     max_contact_iterations: int = 100
     line_search: bool = True
     max_line_search: int = 8
+    # arc-length increments with cohesive active sets (smooth within their frozen sets): give up
+    # when this many iterations in a row stay above 0.9 × the best residual before them
+    # (:func:`stagnates`); 0: off. Newton converges in a few iterations on a smooth problem near
+    # its solution; where it stalls or cycles it does so for good: the DCB by arc length spent
+    # 88 % of its iterations in attempts that ran to max_iterations that way (a frozen loading
+    # point whose normal separation crosses zero in a full step meets the mirror image of its
+    # softening branch, and Newton ping-pongs between the two sides)
+    stagnation_iterations: int = 3
 
 
 @dataclass
@@ -265,6 +273,12 @@ def _sets_key(sets: list[tuple[np.ndarray, np.ndarray]]) -> bytes:
 
 def _contact_cap_message(iterations: int) -> str:
     return f"no equilibrium after {iterations} iterations with contact ([steps] max_contact_iterations)"
+
+
+def stagnates(residuals: list[float], n: int) -> bool:
+    """The last ``n`` residuals all stay above 0.9 × the smallest one before them (a Newton
+    iteration that stalls or cycles; ``n`` = 0: never)."""
+    return n > 0 and len(residuals) > n + 1 and min(residuals[-n:]) >= 0.9 * min(residuals[:-n])
 
 
 def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
