@@ -36,12 +36,24 @@ def flops_per_point(m: int) -> float:
     return 2 * 36 * m + 2 * 6 * m * m + 2 * a * 9 + 2 * a * a * 3 + 2 * 6 * m
 
 
-def roofline(n: int = 2000, repeat: int = 3) -> float:
+def roofline(n: int = 2000, repeat: int = 3, threads: int | None = None) -> float:
+    """GFLOP/s of NumPy's float64 matmul of two n × n matrices with ``threads`` BLAS threads
+    (default all CPUs of this process, whatever OMP_NUM_THREADS says)."""
+    from layershell.threads import controller
+
     A = np.random.default_rng(0).standard_normal((n, n))
     B = A.T.copy()
-    A @ B
-    t = min(_timed(lambda: A @ B) for _ in range(repeat))
+    with controller().limit(limits=threads or _cpus(), user_api="blas"):
+        A @ B
+        t = min(_timed(lambda: A @ B) for _ in range(repeat))
     return 2 * n**3 / t / 1e9
+
+
+def _cpus() -> int:
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        return os.cpu_count() or 1
 
 
 def _timed(fn) -> float:
@@ -69,8 +81,17 @@ def main() -> None:
     th = np.full((ne, 9), 0.1)
     mat = Orthotropic(3.4e4, 3.6e4, 3.4e4, 1.5e4, 1.45e4, 1.45e4, 0.17, 0.17, 0.17)
     other = "full" if a.element == "mitc" else "mitc"
-    blocks = [layer_block(X, th * k, th, d, mat, 15.0, element=a.element) for k in (0, 1)]
-    blocks_other = [layer_block(X, th * k, th, d, mat, 15.0, element=other) for k in (0, 1)]
+    # thickness points as assembly.build_blocks chooses them (thickness_points = 3): the full
+    # element max(3, d) (fewer than d give spurious modes, tests/test_element_rank.py), MITC9
+    # max(3, d + 1); the full element is also timed with the MITC9's points (equal-points ratio)
+    nz = {"full": max(3, d), "mitc": max(3, d + 1)}
+
+    def blocks_of(element, n_thickness):
+        return [layer_block(X, th * k, th, d, mat, 15.0, n_thickness=n_thickness, element=element) for k in (0, 1)]
+
+    blocks = blocks_of(a.element, nz[a.element])
+    blocks_other = blocks_of(other, nz[other])
+    blocks_equal = blocks_of("full", nz["mitc"]) if nz["full"] != nz["mitc"] else None
     rng = np.random.default_rng(1)
     U = [1e-3 * rng.standard_normal((ne, na, 3)) for _ in blocks]
 
@@ -88,21 +109,33 @@ def main() -> None:
     run()
     layer_response(blocks_other[0], U[0][:1], True, True, slice(0, 1))
     run(blocks_other)
-    times, times_other = [], []
-    for _ in range(a.repeat):  # interleaved, so that load changes on a shared machine hit both alike
+    if blocks_equal is not None:
+        run(blocks_equal)
+    times, times_other, times_equal = [], [], []
+    for _ in range(a.repeat):  # interleaved, so that load changes on a shared machine hit all alike
         times.append(_timed(run))
         times_other.append(_timed(lambda: run(blocks_other)))
+        if blocks_equal is not None:
+            times_equal.append(_timed(lambda: run(blocks_equal)))
     t, t_other = min(times), min(times_other)
+    t_mitc, t_full = (t, t_other) if a.element == "mitc" else (t_other, t)
+    t_equal = min(times_equal) if times_equal else t_full
     q = blocks[0].dV.shape[1]
     fl = 2 * q * flops_per_point(3 * na) * ne
     achieved = fl / t / 1e9
     peak = roofline()
+    peak1 = roofline(threads=1)
     print(json.dumps({"elements": ne, "dofs_per_element": 6 * na, "directors": d, "seconds": round(t, 4),
                       "elements_per_second": round(ne / t, 1), "gflops": round(achieved, 3),
-                      "roofline_gflops": round(peak, 3), "mflop_per_element": round(fl / ne / 1e6, 3),
+                      "roofline_gflops": round(peak, 3),
+                      "roofline_cpus": _cpus(), "roofline_gflops_one_cpu": round(peak1, 3),
+                      "share_of_one_cpu_roofline": round(achieved / peak1, 4), "mflop_per_element": round(fl / ne / 1e6, 3),
                       "threads": kernel_threads(), "element": a.element,
                       f"seconds_{other}": round(t_other, 4),
-                      "time_ratio_mitc_over_full": round(t / t_other if a.element == "mitc" else t_other / t, 3),
+                      "time_ratio_mitc_over_full": round(t_mitc / t_full, 3),
+                      "thickness_points": nz,
+                      "seconds_full_at_mitc_points": round(t_equal, 4),
+                      "time_ratio_mitc_over_full_equal_points": round(t_mitc / t_equal, 3),
                       "integration_points_per_layer": q, "first_call_seconds": round(first, 3),
                       "max_rel_deviation_from_reference": float(f"{dev:.2e}"),
                       "load_average": [round(x, 2) for x in os.getloadavg()]}))
