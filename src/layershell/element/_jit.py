@@ -99,13 +99,14 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 @njit(cache=True, nogil=True, fastmath=True)
 def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
-               f, B, GS, GT):  # pragma: no cover
+               f, B, sigma, GS, GT):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
     covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
     (only the frame directions a point is tied in), the tied stresses σ = Ĉ E with the level's
     tied stiffness Ĉ = Σ_q H_qᵀ C̃_q H_q (``Lh`` its lower factor L̂ when ``lower``, else Ĉ);
     internal force f (e, m) = Σ_k σ_k B_k with m = 3a (DOF index 3·a + k); on request the rows
-    B (e, z, nT, m) (``want_b``; else B is a (1, 1, nT, m) work array) and the geometric operands
+    B (e, z, nT, m) and the stresses σ (e, z, nT) instead of f (``want_b``: the caller forms
+    f = Bᵀ σ with BLAS; else B is a (1, 1, nT, m) work array) and the geometric operands
     GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
     point p, the ties k and the directions J with σ_JK(p) = σ_k."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
@@ -132,9 +133,11 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
             iz = z if want_b else 0
             for p in range(P):
                 th = thL[e, z, p]
-                for l in range(nd):
-                    pw[l] = th ** l
-                    dpw[l] = l * th ** (l - 1) if l > 0 else 0.0
+                pw[0] = 1.0
+                dpw[0] = 0.0
+                for l in range(1, nd):
+                    pw[l] = pw[l - 1] * th
+                    dpw[l] = l * pw[l - 1]
                 for r in range(ndir[p]):
                     b = dirs[p, r]
                     m0, m1, m2 = M[e, z, p, 0, b], M[e, z, p, 1, b], M[e, z, p, 2, b]
@@ -197,10 +200,14 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
                     for k2 in range(nT):
                         s += Lh[e, z, k, k2] * Ek[k2]
                     sig[k] = s
-            for k in range(nT):
-                v = sig[k]
-                for r in range(m):
-                    f[e, r] += v * B[ie, iz, k, r]
+            if want_b:
+                for k in range(nT):
+                    sigma[e, z, k] = sig[k]
+            else:
+                for k in range(nT):
+                    v = sig[k]
+                    for r in range(m):
+                        f[e, r] += v * B[0, 0, k, r]
             if want_geo:
                 for p in range(P):
                     for r in range(ndir[p]):
