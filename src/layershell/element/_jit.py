@@ -124,9 +124,12 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
     dpw = np.empty(nd)
     pi = np.array([0, 1, 2, 1, 0, 0])
     pj = np.array([0, 1, 2, 2, 2, 1])
+    Ut = np.empty((3, na))
     for e in range(ne):
         for r in range(m):
             f[e, r] = 0.0
+        for a in range(na):
+            Ut[0, a], Ut[1, a], Ut[2, a] = U[e, a, 0], U[e, a, 1], U[e, a, 2]
         col = 0
         ie = e if want_b else 0
         for z in range(nz):
@@ -141,19 +144,19 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
                 for r in range(ndir[p]):
                     b = dirs[p, r]
                     m0, m1, m2 = M[e, z, p, 0, b], M[e, z, p, 1, b], M[e, z, p, 2, b]
-                    D0 = 0.0
-                    D1 = 0.0
-                    D2 = 0.0
                     for n in range(9):
                         dn = dNn[p, n, 0] * m0 + dNn[p, n, 1] * m1
                         nn = Nn[p, n] * m2
                         for l in range(nd):
-                            a = n * nd + l
-                            v = dn * pw[l] + nn * dpw[l]  # derivative of phi_a along F_b
-                            dphi[p, b, a] = v
-                            D0 += v * U[e, a, 0]
-                            D1 += v * U[e, a, 1]
-                            D2 += v * U[e, a, 2]
+                            dphi[p, b, n * nd + l] = dn * pw[l] + nn * dpw[l]  # derivative of phi_a along F_b
+                    D0 = 0.0
+                    D1 = 0.0
+                    D2 = 0.0
+                    for a in range(na):
+                        v = dphi[p, b, a]
+                        D0 += v * Ut[0, a]
+                        D1 += v * Ut[1, a]
+                        D2 += v * Ut[2, a]
                     D[p, b, 0], D[p, b, 1], D[p, b, 2] = D0, D1, D2
                     for k in range(3):
                         gg[p, b, k] = G[e, z, p, k, b] + (D[p, b, k] if nonlinear else 0.0)
