@@ -2,20 +2,42 @@
 
     python benchmarks/kernel.py [--elements 2000] [--repeat 3] [--element mitc|full] [--directors 3]
 
-Internal force + tangent of a 2-layer, d = 3 element (216 DOFs, 2 × 27 integration points with
-the full element, 2 × 36 with MITC9, which needs d + 1 thickness points),
-over many elements. Flops counted for the mathematically necessary work per point: the material
-part Bᵀ (C B) (2·6·6·m + 2·6·m² with m = 108 layer DOFs), the geometric part gᵀ S g (2·a·9 +
-2·a²·3, a = 36 basis functions) and the force Bᵀ S (2·6·m); no symmetry savings. The roofline is
-NumPy's float64 matmul of two 2000 × 2000 matrices (all cores) in the same run.
-Last line: ``roofline_share=<achieved/roofline>``.
+Internal force + tangent (nonlinear) of a 2-layer element over many elements, both kernels timed
+interleaved. Thickness points as ``assembly.build_blocks`` chooses them with the default
+``thickness_points = 3``: the full element max(3, d) (fewer than d points give spurious
+zero-energy modes, tests/test_element_rank.py), MITC9 max(3, d + 1) (with d points it has six);
+for d ≥ 3 the full element is timed a second time with the MITC9's points
+(``time_ratio_mitc_over_full_equal_points``, the cost per integration point). For d = 3: 216
+DOFs, 2 × 27 integration points (full) and 2 × 36 (MITC9). Flops counted for the mathematically
+necessary work per point: the material part Bᵀ (C B) (2·6·6·m + 2·6·m² with m = 27(d+1) layer
+DOFs), the geometric part gᵀ S g (2·a·9 + 2·a²·3, a = m/3 basis functions) and the force Bᵀ S
+(2·6·m); no symmetry savings. The roofline is NumPy's float64 matmul of two 2000 × 2000 matrices
+with all CPUs (``roofline_gflops``, the last line ``roofline_share=<achieved/roofline>``) and with
+one CPU (``share_of_one_cpu_roofline``: a 1-thread kernel can reach at most 1/cores of the first).
 
-The kernel itself does less work than counted where it can: the material part is one symmetric
-rank-k product per element (BLAS syrk, half the counted 2·6·m² per point, see
-``layershell.element.kernel``); that saving shows as a higher share, the count stays the same.
-Also printed: the kernel's threads (``LAYERSHELL_THREADS``), the first call (Numba compile or
-cache load), the deviation from the plain NumPy reference on a few elements, and the load average
-(timings on a shared machine are noisy: compare runs at similar load).
+The kernels do less work than counted where they can: the full element's material part is one
+symmetric rank-k product per element (BLAS syrk, half the counted 2·6·m² per point, 6 rows per
+point); MITC9's works in the tie space (37 tied strains per level instead of 6 × 9, one BLAS
+product with the Cholesky factor of the level's tied stiffness, then the syrk; see
+``layershell.element.mitc._mitc_range``). Also printed: the kernel's threads
+(``LAYERSHELL_THREADS``), the first call (Numba compile or cache load), the deviation from the
+plain NumPy reference on a few elements, and the load average (timings on a shared machine are
+noisy: compare runs at similar load).
+
+Measured 24 Nov 2026, 1000 elements, 1 thread, 2-core machine shared with solver runs (load
+average 1.3-2.1; s = both layers, min of 3):
+
+| d | points MITC9 / full | MITC9 s (before → after this session) | full s | per element | equal points |
+|---|---|---|---|---|---|
+| 1 | 3 / 3 | 0.083 → 0.075 | 0.057 | 1.45 → 1.32 | 1.32 |
+| 2 | 3 / 3 | 0.128 → 0.118 | 0.094 | 1.36 → 1.25 | 1.25 |
+| 3 | 4 / 3 | 0.254 → 0.211 | 0.157 | 1.62 → 1.35 | 1.34 → 1.10 |
+| 4 | 5 / 4 | 0.46 → 0.379 | 0.312 | 1.48 → 1.21 | 1.24 → 1.02 |
+
+Roofline share (1 thread): 0.16 (d = 1) to 0.29 (d = 3, 4) of the 2-CPU roofline when the
+machine was quiet enough to give ~195 GFLOP/s; 0.31 (d = 1) to 0.56 (d = 3) of one CPU (~98
+GFLOP/s). With the other core busy, ``LAYERSHELL_THREADS=2`` was no faster than 1 (and the 2-CPU
+roofline fell to ~88 GFLOP/s), so the 2-thread share could not be measured cleanly here.
 """
 from __future__ import annotations
 
