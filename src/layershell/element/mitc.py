@@ -21,8 +21,11 @@ C̃ = Tᵀ C T dV (T the Voigt form of that map), so that with S̃ = C̃ Ẽ
 * K = Σ_q B̃ᵀ C̃ B̃ + δ_kl Σ_p ∂_i phi_a σ_ij(p) ∂_j phi_b,  σ_c(p) = Σ_q h_c(q, p) S̃_c(q)
 
 (the geometric part from the exact second derivatives of the tied strains; h_c the tying
-functions). The total-Lagrangian form of the full element (``kernel.py``) is the special case
-"every component sampled at the Gauss point"; :func:`tying` with ``full=True`` gives it (test).
+functions). The compiled kernel (:func:`mitc_response`) evaluates this in the tie space: with the
+37 tie strains E and rows B of a level, Σ_q B̃ᵀ C̃ B̃ = Bᵀ Ĉ B and f = Bᵀ Ĉ E, Ĉ = Σ_q H_qᵀ C̃_q H_q
+(:func:`tied_stiffness`, factored once per block). The total-Lagrangian form of the full
+element (``kernel.py``) is the special case "every component sampled at the Gauss point";
+:func:`tying` with ``full=True`` gives it (test).
 
 The components are taken in a frame F_b (:func:`strain_frames`): by default the centre frame
 transported to each point (so that the membrane patch test is exact on straight-edged distorted
