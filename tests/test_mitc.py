@@ -97,6 +97,20 @@ def test_fast_kernel_equals_reference(rng, d, nonlinear):
     assert _rel(f2, f0[4:13]) < 1e-12 and _rel(K2, K0[4:13]) < 1e-12
 
 
+@pytest.mark.parametrize("d", [1, 3])
+@pytest.mark.parametrize("nonlinear", [True, False])
+def test_fast_kernel_force_only_equals_reference(rng, d, nonlinear):
+    """Without the tangent the compiled kernel forms f from the point stresses (no strain rows)."""
+    n = 11
+    X = np.concatenate([curved_element(rng) for _ in range(n)])
+    Hb, H = _layer(rng, n)
+    blk = layer_block(X, Hb, H, d, ORTHO, 20.0, element="mitc")
+    U = 0.05 * rng.standard_normal((n, 9 * (d + 1), 3))
+    f0, _ = layer_response_reference(blk, U, nonlinear, False)
+    f1, K1 = layer_response(blk, U, nonlinear, False)
+    assert K1 is None and _rel(f1, f0) < 1e-12
+
+
 def test_fast_kernel_without_factor(rng):
     """C̃ not positive definite (a negative volume weight): the general product path."""
     import dataclasses

@@ -106,7 +106,7 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
     tied stiffness Ĉ = Σ_q H_qᵀ C̃_q H_q (``Lh`` its lower factor L̂ when ``lower``, else Ĉ);
     internal force f (e, m) = Σ_k σ_k B_k with m = 3a (DOF index 3·a + k); on request the rows
     B (e, z, nT, m) and the stresses σ (e, z, nT) instead of f (``want_b``: the caller forms
-    f = Bᵀ σ with BLAS; else B is a (1, 1, nT, m) work array) and the geometric operands
+    f = Bᵀ σ with BLAS; else f = Σ_p Σ_K GS_K g_K without rows, B unused) and the geometric operands
     GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
     point p, the ties k and the directions J with σ_JK(p) = σ_k."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
@@ -125,6 +125,7 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
     pi = np.array([0, 1, 2, 1, 0, 0])
     pj = np.array([0, 1, 2, 2, 2, 1])
     Ut = np.empty((3, na))
+    gsa = np.empty(na)
     for e in range(ne):
         for r in range(m):
             f[e, r] = 0.0
@@ -171,6 +172,8 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
                         if nonlinear:
                             s += 0.5 * D[p, i, k] * D[p, j, k]
                     Ek[k0] = s if i == j else 2.0 * s
+                    if not want_b:
+                        continue
                     gi0, gi1, gi2 = gg[p, i, 0], gg[p, i, 1], gg[p, i, 2]
                     gj0, gj1, gj2 = gg[p, j, 0], gg[p, j, 1], gg[p, j, 2]
                     if i == j:
@@ -188,10 +191,11 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
             # tied stresses σ = Ĉ E = L̂ (L̂ᵀ E)
             if lower:
                 for W in range(nT):
-                    s = 0.0
-                    for k in range(W, nT):
-                        s += Lh[e, z, k, W] * Ek[k]
-                    yk[W] = s
+                    yk[W] = 0.0
+                for k in range(nT):  # y = L̂ᵀ E row by row (contiguous rows of L̂)
+                    v = Ek[k]
+                    for W in range(k + 1):
+                        yk[W] += Lh[e, z, k, W] * v
                 for k in range(nT):
                     s = 0.0
                     for W in range(k + 1):
@@ -206,11 +210,24 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
             if want_b:
                 for k in range(nT):
                     sigma[e, z, k] = sig[k]
-            else:
-                for k in range(nT):
-                    v = sig[k]
-                    for r in range(m):
-                        f[e, r] += v * B[0, 0, k, r]
+            else:  # f_a = Σ_p Σ_K (Σ_J ∂_J phi_a σ_JK) g_K, without the rows
+                for p in range(P):
+                    for r in range(ndir[p]):
+                        K = dirs[p, r]
+                        g0, g1, g2 = gg[p, K, 0], gg[p, K, 1], gg[p, K, 2]
+                        v = sig[gk[p, r, 0]]
+                        J = gJ[p, r, 0]
+                        for a in range(na):
+                            gsa[a] = v * dphi[p, J, a]
+                        for h in range(1, gn[p, r]):
+                            v = sig[gk[p, r, h]]
+                            J = gJ[p, r, h]
+                            for a in range(na):
+                                gsa[a] += v * dphi[p, J, a]
+                        for a in range(na):
+                            f[e, 3 * a] += gsa[a] * g0
+                            f[e, 3 * a + 1] += gsa[a] * g1
+                            f[e, 3 * a + 2] += gsa[a] * g2
             if want_geo:
                 for p in range(P):
                     for r in range(ndir[p]):
