@@ -352,7 +352,7 @@ def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = T
 _SUB = 8  # elements per sub-block (as in kernel.py)
 
 
-_GEMM_BELOW = 100  # m below which Xᵀ X is faster as a general product (BLAS syrk is slow for small m)
+_GEMM_BELOW = 60  # m below which Xᵀ X is faster as a general product (d ≤ 1: OpenBLAS syrk is slow for small m)
 
 
 def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int, hi: int) -> None:
