@@ -98,7 +98,7 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
+def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
                f, B, sigma, GS, GT):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
     covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
@@ -163,7 +163,7 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, dirs, ndir, gn, gk, gJ, Lh, U, d, n
                         gg[p, b, k] = G[e, z, p, k, b] + (D[p, b, k] if nonlinear else 0.0)
             for c in range(6):
                 i, j = pi[c], pj[c]
-                for t in range(off[c + 1] - off[c]):
+                for t in range(nt[c]):
                     k0 = off[c] + t
                     p = pts[c, t]
                     s = 0.0

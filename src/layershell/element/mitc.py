@@ -68,7 +68,9 @@ class Tying:
     pts (6, T) int: point index of tie t of Voigt component c (padded), n (6,): ties per component
     w (6, 9, T): weight of tie t of component c at Gauss point q (Ẽ_c(q) = Σ_t w E_c(pts[c, t]))
     dirs (P, 3) int, ndir (P,): the directions K with non-zero rows of the tied stress at point p
-    off (7,) int: tie t of component c is entry k = off[c] + t of the tie space (nT = off[6] ties)
+    off (7,) int: tie t of component c is entry k = off[c] + t of the tie space (nT = off[6] ties),
+    ordered E_11, E_22, E_33, E_12 (the first ``n_normal`` entries), then E_23, E_13 (the transverse
+    shear, decoupled from the others where the material's third axis is the normal)
     gn (P, 3), gk, gJ (P, 3, 3) int: for the r-th direction K = dirs[p, r], the gn ties k and the
     directions J with σ_JK(p) = σ_k (the geometric term's stress rows)
     """
@@ -84,11 +86,15 @@ class Tying:
     gk: np.ndarray
     gJ: np.ndarray
 
+    @property
+    def n_normal(self) -> int:
+        return int(self.n[[0, 1, 2, 5]].sum())
+
     def tie_space(self) -> np.ndarray:
         """H (9, 6, nT): Ẽ_c(q) = Σ_k H[q, c, k] E_k, E_k the tie-space strains."""
         H = np.zeros((9, 6, int(self.off[-1])))
         for c in range(6):
-            H[:, c, self.off[c]:self.off[c + 1]] = self.w[c, :, :self.n[c]]
+            H[:, c, self.off[c]:self.off[c] + self.n[c]] = self.w[c, :, :self.n[c]]
         return H
 
     def dense(self) -> np.ndarray:
@@ -140,7 +146,11 @@ def tying(full: bool = False) -> Tying:
     for p in range(P):
         dd = np.flatnonzero(used[p])
         dirs[p, :len(dd)] = dd
-    off = np.concatenate([[0], np.cumsum(n)]).astype(np.int64)
+    off = np.zeros(7, np.int64)
+    order = (0, 1, 2, 5, 3, 4)  # normal and in-plane shear components first, transverse shear last
+    for c0, c1 in zip(order[:-1], order[1:]):
+        off[c1] = off[c0] + n[c0]
+    off[6] = n.sum()
     gn = np.zeros((P, 3), np.int64)
     gk = np.zeros((P, 3, 3), np.int64)
     gJ = np.zeros((P, 3, 3), np.int64)
@@ -184,7 +194,9 @@ class MitcBlock:
     G (e, z, P, 3, 3): the strain frame vectors F_b (columns) there; M (e, z, P, 3, 3) = G⁻¹F
     Ct (e, z, 9, 6, 6): covariant stiffness Tᵀ C T dV at the Gauss points; L (e, z, nT, nT): the
     lower Cholesky factor of the level's tied stiffness Ĉ (:func:`tied_stiffness`), or None where
-    Ĉ is not positive definite; C (e, z·9, 6, 6), dV (e, z·9): Cartesian stiffness and volume weights (z-major)
+    Ĉ is not positive definite; C (e, z·9, 6, 6), dV (e, z·9): Cartesian stiffness and volume
+    weights (z-major); split: ``tie.n_normal`` where Ĉ does not couple the transverse shear ties
+    with the others (L block diagonal: two smaller factor products), else 0
     """
 
     d: int
@@ -198,6 +210,7 @@ class MitcBlock:
     L: np.ndarray | None
     C: np.ndarray
     dV: np.ndarray
+    split: int = 0
 
     @property
     def n_dof(self) -> int:
@@ -263,18 +276,25 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
     T = covariant_map(np.linalg.inv(Fq))  # (e, q, z, 6, 6): rows of F⁻¹ = dual vectors F^i
     Ct = np.einsum("eqzVc,eqVW,eqzWd->ezqcd", T, C, T) * dV.transpose(0, 2, 1)[..., None, None]
     Ct = np.ascontiguousarray(0.5 * (Ct + np.swapaxes(Ct, -1, -2)))
-    L = None
+    L, split = None, 0
     if np.all(dV > 0):
+        Ch = tied_stiffness(Ct, tie)
+        nO = tie.n_normal
+        coupling = np.abs(Ch[..., :nO, nO:]).max(axis=(-1, -2))
+        if np.all(coupling <= 1e-12 * np.abs(Ch).max(axis=(-1, -2))):  # round-off: material axis 3 = normal
+            Ch[..., :nO, nO:] = 0.0
+            Ch[..., nO:, :nO] = 0.0
+            split = nO
         try:
-            L = np.ascontiguousarray(np.linalg.cholesky(tied_stiffness(Ct, tie)))
+            L = np.ascontiguousarray(np.linalg.cholesky(Ch))
         except np.linalg.LinAlgError:
-            L = None
+            L, split = None, 0
     e, q, z = dV.shape
     Cz = np.ascontiguousarray(np.broadcast_to(C[:, None], (e, z, q, 6, 6)).reshape(e, z * q, 6, 6))
     N, dN, _ = _quad9(tie.points)
     return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
                      np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),
-                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)))
+                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)), split)
 
 
 def tied_stiffness(Ct: np.ndarray, tie: Tying) -> np.ndarray:
@@ -382,14 +402,22 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         sig = np.empty((nb, nz, nT) if tangent else (0, 0, 0))
         Lh = block.L[g0:g1] if lower else np.ascontiguousarray(tied_stiffness(block.Ct[g0:g1], tie))
         _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.off,
-                        tie.dirs, tie.ndir, tie.gn, tie.gk, tie.gJ, Lh, U[s:t], d, nonlinear, tangent, geo, lower,
-                        f[s:t], B, sig, GS, GT)
+                        tie.n, tie.dirs, tie.ndir, tie.gn, tie.gk, tie.gJ, Lh, U[s:t], d, nonlinear, tangent, geo,
+                        lower, f[s:t], B, sig, GS, GT)
         if not tangent:
             continue
         np.matmul(sig.reshape(nb, 1, nz * nT), B.reshape(nb, nz * nT, m), out=f[s:t, None, :])  # f = Bᵀ σ
         Br = B.reshape(nb, nz * nT, m).transpose(0, 2, 1)
         if lower:
-            X = np.matmul(Lh.transpose(0, 1, 3, 2), B).reshape(nb, nz * nT, m)
+            Lt = Lh.transpose(0, 1, 3, 2)
+            if block.split:  # L̂ block diagonal: normal/in-plane ties and transverse shear ties apart
+                h = block.split
+                X = np.empty_like(B)
+                np.matmul(Lt[:, :, :h, :h], B[:, :, :h], out=X[:, :, :h])
+                np.matmul(Lt[:, :, h:, h:], B[:, :, h:], out=X[:, :, h:])
+                X = X.reshape(nb, nz * nT, m)
+            else:
+                X = np.matmul(Lt, B).reshape(nb, nz * nT, m)
             if m < _GEMM_BELOW:
                 np.matmul(X.transpose(0, 2, 1), X.copy(), out=K[s:t])
             else:  # NumPy dispatches a matrix times its own transpose to BLAS syrk
