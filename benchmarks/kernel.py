@@ -17,27 +17,29 @@ one CPU (``share_of_one_cpu_roofline``: a 1-thread kernel can reach at most 1/co
 
 The kernels do less work than counted where they can: the full element's material part is one
 symmetric rank-k product per element (BLAS syrk, half the counted 2·6·m² per point, 6 rows per
-point); MITC9's works in the tie space (37 tied strains per level instead of 6 × 9, one BLAS
-product with the Cholesky factor of the level's tied stiffness, then the syrk; see
-``layershell.element.mitc._mitc_range``). Also printed: the kernel's threads
-(``LAYERSHELL_THREADS``), the first call (Numba compile or cache load), the deviation from the
-plain NumPy reference on a few elements, and the load average (timings on a shared machine are
-noisy: compare runs at similar load).
+point); MITC9's works in the tie space (37 tied strains per level instead of 6 × 9 rows, one BLAS
+product with the Cholesky factor of the level's tied stiffness, block diagonal with the transverse
+shear apart, then the syrk; see ``layershell.element.mitc._mitc_range``). Also printed: the
+kernel's threads (``LAYERSHELL_THREADS``), the first call (Numba compile or cache load), the
+deviation from the plain NumPy reference on a few elements, and the load average (timings on a
+shared machine are noisy: compare runs at similar load).
 
 Measured 24 Nov 2026, 1000 elements, 1 thread, 2-core machine shared with solver runs (load
-average 1.3-2.1; s = both layers, min of 3):
+average 1.8-2.3; s = both layers, min of 3, two runs; "before" = the kernel at the start of that
+session, load 1.3-2.1):
 
-| d | points MITC9 / full | MITC9 s (before → after this session) | full s | per element | equal points |
+| d | points MITC9 / full | MITC9 s (before → after) | full s | per element | equal points |
 |---|---|---|---|---|---|
-| 1 | 3 / 3 | 0.083 → 0.075 | 0.057 | 1.45 → 1.32 | 1.32 |
-| 2 | 3 / 3 | 0.128 → 0.118 | 0.094 | 1.36 → 1.25 | 1.25 |
-| 3 | 4 / 3 | 0.254 → 0.211 | 0.157 | 1.62 → 1.35 | 1.34 → 1.10 |
-| 4 | 5 / 4 | 0.46 → 0.379 | 0.312 | 1.48 → 1.21 | 1.24 → 1.02 |
+| 1 | 3 / 3 | 0.083 → 0.064 | 0.057 | 1.45 → 1.11-1.15 | the same |
+| 2 | 3 / 3 | 0.128 → 0.105 | 0.095 | 1.36 → 1.09-1.12 | the same |
+| 3 | 4 / 3 | 0.25 → 0.19 | 0.145 | 1.62-1.71 → 1.31-1.32 | 1.34 → 1.01 |
+| 4 | 5 / 4 | 0.43-0.47 → 0.35 | 0.29 | 1.45-1.48 → 1.19-1.25 | 1.23 → 1.02 |
 
-Roofline share (1 thread): 0.16 (d = 1) to 0.29 (d = 3, 4) of the 2-CPU roofline when the
-machine was quiet enough to give ~195 GFLOP/s; 0.31 (d = 1) to 0.56 (d = 3) of one CPU (~98
-GFLOP/s). With the other core busy, ``LAYERSHELL_THREADS=2`` was no faster than 1 (and the 2-CPU
-roofline fell to ~88 GFLOP/s), so the 2-thread share could not be measured cleanly here.
+Roofline share with 1 thread: the all-CPU roofline is ~196 GFLOP/s when the other core is free
+(share 0.17 at d = 1, 0.23 at d = 2; d = 3, 4 reach 59-63 GFLOP/s, i.e. 0.30-0.32 of it) and
+87-91 GFLOP/s when it is busy (share 0.40-0.69); of one CPU (~98 GFLOP/s) 0.34 (d = 1), 0.47
+(d = 2), 0.60 (d = 3), 0.62 (d = 4). With the other core busy ``LAYERSHELL_THREADS=2`` was no
+faster than 1 thread, so the 2-thread share could not be measured cleanly here.
 """
 from __future__ import annotations
 
