@@ -99,14 +99,13 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 @njit(cache=True, nogil=True, fastmath=True)
 def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
-               f, B, sigma, GS, GT):  # pragma: no cover
+               f, B, GS, GT):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
     covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
     (only the frame directions a point is tied in), the tied stresses σ = Ĉ E with the level's
     tied stiffness Ĉ = Σ_q H_qᵀ C̃_q H_q (``Lh`` its lower factor L̂ when ``lower``, else Ĉ);
-    internal force f (e, m) = Σ_k σ_k B_k with m = 3a (DOF index 3·a + k); on request the rows
-    B (e, z, nT, m) and the stresses σ (e, z, nT) instead of f (``want_b``: the caller forms
-    f = Bᵀ σ with BLAS; else f = Σ_p Σ_K GS_K g_K without rows, B unused) and the geometric operands
+    internal force f (e, m) = Σ_k σ_k B_k = Σ_p Σ_K GS_K g_K with m = 3a (DOF index 3·a + k); on
+    request the rows B (e, z, nT, m) (``want_b``; else B is unused) and the geometric operands
     GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
     point p, the ties k and the directions J with σ_JK(p) = σ_k."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
@@ -126,15 +125,13 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
     pj = np.array([0, 1, 2, 2, 2, 1])
     Ut = np.empty((3, na))
     gsa = np.empty(na)
+    ft = np.empty((3, na))
     for e in range(ne):
-        for r in range(m):
-            f[e, r] = 0.0
         for a in range(na):
             Ut[0, a], Ut[1, a], Ut[2, a] = U[e, a, 0], U[e, a, 1], U[e, a, 2]
+            ft[0, a] = ft[1, a] = ft[2, a] = 0.0
         col = 0
-        ie = e if want_b else 0
         for z in range(nz):
-            iz = z if want_b else 0
             for p in range(P):
                 th = thL[e, z, p]
                 pw[0] = 1.0
@@ -179,15 +176,15 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
                     if i == j:
                         for a in range(na):
                             di = dphi[p, i, a]
-                            B[ie, iz, k0, 3 * a] = gi0 * di
-                            B[ie, iz, k0, 3 * a + 1] = gi1 * di
-                            B[ie, iz, k0, 3 * a + 2] = gi2 * di
+                            B[e, z, k0, 3 * a] = gi0 * di
+                            B[e, z, k0, 3 * a + 1] = gi1 * di
+                            B[e, z, k0, 3 * a + 2] = gi2 * di
                     else:
                         for a in range(na):
                             di, dj = dphi[p, i, a], dphi[p, j, a]
-                            B[ie, iz, k0, 3 * a] = gi0 * dj + gj0 * di
-                            B[ie, iz, k0, 3 * a + 1] = gi1 * dj + gj1 * di
-                            B[ie, iz, k0, 3 * a + 2] = gi2 * dj + gj2 * di
+                            B[e, z, k0, 3 * a] = gi0 * dj + gj0 * di
+                            B[e, z, k0, 3 * a + 1] = gi1 * dj + gj1 * di
+                            B[e, z, k0, 3 * a + 2] = gi2 * dj + gj2 * di
             # tied stresses σ = Ĉ E = L̂ (L̂ᵀ E)
             if lower:
                 for W in range(nT):
@@ -207,40 +204,30 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
                     for k2 in range(nT):
                         s += Lh[e, z, k, k2] * Ek[k2]
                     sig[k] = s
-            if want_b:
-                for k in range(nT):
-                    sigma[e, z, k] = sig[k]
-            else:  # f_a = Σ_p Σ_K (Σ_J ∂_J phi_a σ_JK) g_K, without the rows
-                for p in range(P):
-                    for r in range(ndir[p]):
-                        K = dirs[p, r]
-                        g0, g1, g2 = gg[p, K, 0], gg[p, K, 1], gg[p, K, 2]
-                        v = sig[gk[p, r, 0]]
-                        J = gJ[p, r, 0]
+            # f_a = Σ_k σ_k B_k = Σ_p Σ_K GS_K g_K with GS_K = Σ_J ∂_J phi σ_JK (the geometric
+            # operand), per tied direction and without the rows: the same arithmetic with and
+            # without the tangent (the residual of a line search equals that of the Newton step)
+            for p in range(P):
+                for r in range(ndir[p]):
+                    K = dirs[p, r]
+                    g0, g1, g2 = gg[p, K, 0], gg[p, K, 1], gg[p, K, 2]
+                    v = sig[gk[p, r, 0]]
+                    J = gJ[p, r, 0]
+                    for a in range(na):
+                        gsa[a] = v * dphi[p, J, a]
+                    for h in range(1, gn[p, r]):
+                        v = sig[gk[p, r, h]]
+                        J = gJ[p, r, h]
                         for a in range(na):
-                            gsa[a] = v * dphi[p, J, a]
-                        for h in range(1, gn[p, r]):
-                            v = sig[gk[p, r, h]]
-                            J = gJ[p, r, h]
-                            for a in range(na):
-                                gsa[a] += v * dphi[p, J, a]
+                            gsa[a] += v * dphi[p, J, a]
+                    for a in range(na):
+                        ft[0, a] += gsa[a] * g0
+                        ft[1, a] += gsa[a] * g1
+                        ft[2, a] += gsa[a] * g2
+                    if want_geo:
                         for a in range(na):
-                            f[e, 3 * a] += gsa[a] * g0
-                            f[e, 3 * a + 1] += gsa[a] * g1
-                            f[e, 3 * a + 2] += gsa[a] * g2
-            if want_geo:
-                for p in range(P):
-                    for r in range(ndir[p]):
-                        K = dirs[p, r]
-                        for a in range(na):
+                            GS[e, col, a] = gsa[a]
                             GT[e, col, a] = dphi[p, K, a]
-                        v = sig[gk[p, r, 0]]
-                        J = gJ[p, r, 0]
-                        for a in range(na):
-                            GS[e, col, a] = v * dphi[p, J, a]
-                        for h in range(1, gn[p, r]):
-                            v = sig[gk[p, r, h]]
-                            J = gJ[p, r, h]
-                            for a in range(na):
-                                GS[e, col, a] += v * dphi[p, J, a]
                         col += 1
+        for a in range(na):
+            f[e, 3 * a], f[e, 3 * a + 1], f[e, 3 * a + 2] = ft[0, a], ft[1, a], ft[2, a]

@@ -396,17 +396,15 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         t = min(s + _SUB, hi)
         nb = t - s
         g0, g1 = sl0 + s, sl0 + t
-        B = np.empty((nb, nz, nT, m) if tangent else (1, 1, nT, m))
+        B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
         GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))
         GT = np.empty_like(GS)
-        sig = np.empty((nb, nz, nT) if tangent else (0, 0, 0))
         Lh = block.L[g0:g1] if lower else np.ascontiguousarray(tied_stiffness(block.Ct[g0:g1], tie))
         _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.off,
                         tie.n, tie.dirs, tie.ndir, tie.gn, tie.gk, tie.gJ, Lh, U[s:t], d, nonlinear, tangent, geo,
-                        lower, f[s:t], B, sig, GS, GT)
+                        lower, f[s:t], B, GS, GT)
         if not tangent:
             continue
-        np.matmul(sig.reshape(nb, 1, nz * nT), B.reshape(nb, nz * nT, m), out=f[s:t, None, :])  # f = Bᵀ σ
         Br = B.reshape(nb, nz * nT, m).transpose(0, 2, 1)
         if lower:
             Lt = Lh.transpose(0, 1, 3, 2)
