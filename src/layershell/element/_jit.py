@@ -98,145 +98,136 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def mitc_terms(Nn, dNn, thL, G, M, pts, nt, w, dirs, ndir, Ct, L, U, d, nonlinear, want_x, want_geo, lower,
-               f, X, GS, GT):  # pragma: no cover
-    """MITC9 layer kernel per element and thickness level (``mitc.py``): covariant strains and
-    their rows at the tying points (only the frame directions a point is tied in), tied to the
-    Gauss points; internal force f (e, m) with m = 3a (DOF index 3·a + k), on request
-    X (e, z·9, 6, m) = Lᵀ B̃ (L the lower factor of the covariant stiffness C̃ when ``lower``,
-    else any map) and the geometric operands GS = ∂phi σ, GT = ∂phi (e, a, columns)."""
+def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
+               f, B, GS, GT):  # pragma: no cover
+    """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
+    covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
+    (only the frame directions a point is tied in), the tied stresses σ = Ĉ E with the level's
+    tied stiffness Ĉ = Σ_q H_qᵀ C̃_q H_q (``Lh`` its lower factor L̂ when ``lower``, else Ĉ);
+    internal force f (e, m) = Σ_k σ_k B_k = Σ_p Σ_K GS_K g_K with m = 3a (DOF index 3·a + k); on
+    request the rows B (e, z, nT, m) (``want_b``; else B is unused) and the geometric operands
+    GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
+    point p, the ties k and the directions J with σ_JK(p) = σ_k."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
+    nT = Lh.shape[2]
     nd = d + 1
     na = 9 * nd
     m = 3 * na
-    T = pts.shape[1]
-    dphi = np.empty((P, na, 3))
+    dphi = np.empty((P, 3, na))
     gg = np.empty((P, 3, 3))
     D = np.empty((P, 3, 3))
-    Ect = np.empty((6, T))
-    Bc = np.empty((6, T, m))
-    Bt = np.empty((6, m))
-    sig = np.empty((6, T))
-    Et = np.empty(6)
-    S = np.empty(6)
+    Ek = np.empty(nT)
+    yk = np.empty(nT)
+    sig = np.empty(nT)
     pw = np.empty(nd)
     dpw = np.empty(nd)
     pi = np.array([0, 1, 2, 1, 0, 0])
     pj = np.array([0, 1, 2, 2, 2, 1])
+    Ut = np.empty((3, na))
+    gsa = np.empty(na)
+    ft = np.empty((3, na))
     for e in range(ne):
-        for r in range(m):
-            f[e, r] = 0.0
+        for a in range(na):
+            Ut[0, a], Ut[1, a], Ut[2, a] = U[e, a, 0], U[e, a, 1], U[e, a, 2]
+            ft[0, a] = ft[1, a] = ft[2, a] = 0.0
         col = 0
         for z in range(nz):
             for p in range(P):
                 th = thL[e, z, p]
-                for l in range(nd):
-                    pw[l] = th ** l
-                    dpw[l] = l * th ** (l - 1) if l > 0 else 0.0
+                pw[0] = 1.0
+                dpw[0] = 0.0
+                for l in range(1, nd):
+                    pw[l] = pw[l - 1] * th
+                    dpw[l] = l * pw[l - 1]
                 for r in range(ndir[p]):
                     b = dirs[p, r]
                     m0, m1, m2 = M[e, z, p, 0, b], M[e, z, p, 1, b], M[e, z, p, 2, b]
-                    D0 = 0.0
-                    D1 = 0.0
-                    D2 = 0.0
                     for n in range(9):
                         dn = dNn[p, n, 0] * m0 + dNn[p, n, 1] * m1
                         nn = Nn[p, n] * m2
                         for l in range(nd):
-                            a = n * nd + l
-                            v = dn * pw[l] + nn * dpw[l]  # derivative of phi_a along F_b
-                            dphi[p, a, b] = v
-                            D0 += v * U[e, a, 0]
-                            D1 += v * U[e, a, 1]
-                            D2 += v * U[e, a, 2]
+                            dphi[p, b, n * nd + l] = dn * pw[l] + nn * dpw[l]  # derivative of phi_a along F_b
+                    D0 = 0.0
+                    D1 = 0.0
+                    D2 = 0.0
+                    for a in range(na):
+                        v = dphi[p, b, a]
+                        D0 += v * Ut[0, a]
+                        D1 += v * Ut[1, a]
+                        D2 += v * Ut[2, a]
                     D[p, b, 0], D[p, b, 1], D[p, b, 2] = D0, D1, D2
                     for k in range(3):
                         gg[p, b, k] = G[e, z, p, k, b] + (D[p, b, k] if nonlinear else 0.0)
             for c in range(6):
                 i, j = pi[c], pj[c]
                 for t in range(nt[c]):
+                    k0 = off[c] + t
                     p = pts[c, t]
                     s = 0.0
                     for k in range(3):
                         s += 0.5 * (G[e, z, p, k, i] * D[p, j, k] + D[p, i, k] * G[e, z, p, k, j])
                         if nonlinear:
                             s += 0.5 * D[p, i, k] * D[p, j, k]
-                    Ect[c, t] = s if i == j else 2.0 * s
-                    sig[c, t] = 0.0
+                    Ek[k0] = s if i == j else 2.0 * s
+                    if not want_b:
+                        continue
                     gi0, gi1, gi2 = gg[p, i, 0], gg[p, i, 1], gg[p, i, 2]
                     gj0, gj1, gj2 = gg[p, j, 0], gg[p, j, 1], gg[p, j, 2]
                     if i == j:
                         for a in range(na):
-                            di = dphi[p, a, i]
-                            Bc[c, t, 3 * a] = gi0 * di
-                            Bc[c, t, 3 * a + 1] = gi1 * di
-                            Bc[c, t, 3 * a + 2] = gi2 * di
+                            di = dphi[p, i, a]
+                            B[e, z, k0, 3 * a] = gi0 * di
+                            B[e, z, k0, 3 * a + 1] = gi1 * di
+                            B[e, z, k0, 3 * a + 2] = gi2 * di
                     else:
                         for a in range(na):
-                            di, dj = dphi[p, a, i], dphi[p, a, j]
-                            Bc[c, t, 3 * a] = gi0 * dj + gj0 * di
-                            Bc[c, t, 3 * a + 1] = gi1 * dj + gj1 * di
-                            Bc[c, t, 3 * a + 2] = gi2 * dj + gj2 * di
-            for q in range(9):
-                for c in range(6):
+                            di, dj = dphi[p, i, a], dphi[p, j, a]
+                            B[e, z, k0, 3 * a] = gi0 * dj + gj0 * di
+                            B[e, z, k0, 3 * a + 1] = gi1 * dj + gj1 * di
+                            B[e, z, k0, 3 * a + 2] = gi2 * dj + gj2 * di
+            # tied stresses σ = Ĉ E = L̂ (L̂ᵀ E)
+            if lower:
+                for W in range(nT):
+                    yk[W] = 0.0
+                for k in range(nT):  # y = L̂ᵀ E row by row (contiguous rows of L̂)
+                    v = Ek[k]
+                    for W in range(k + 1):
+                        yk[W] += Lh[e, z, k, W] * v
+                for k in range(nT):
                     s = 0.0
-                    for t in range(nt[c]):
-                        s += w[c, q, t] * Ect[c, t]
-                    Et[c] = s
-                for c in range(6):
+                    for W in range(k + 1):
+                        s += Lh[e, z, k, W] * yk[W]
+                    sig[k] = s
+            else:
+                for k in range(nT):
                     s = 0.0
-                    for c2 in range(6):
-                        s += Ct[e, z, q, c, c2] * Et[c2]
-                    S[c] = s
-                    for t in range(nt[c]):
-                        sig[c, t] += w[c, q, t] * s
-                if want_x:
-                    for c in range(6):
-                        first = True
-                        for t in range(nt[c]):
-                            wt = w[c, q, t]
-                            if wt != 0.0:
-                                if first:
-                                    for r in range(m):
-                                        Bt[c, r] = wt * Bc[c, t, r]
-                                    first = False
-                                else:
-                                    for r in range(m):
-                                        Bt[c, r] += wt * Bc[c, t, r]
-                        if first:
-                            for r in range(m):
-                                Bt[c, r] = 0.0
-                    row = z * 9 + q
-                    for W in range(6):
-                        c0 = W if lower else 0
-                        lw = L[e, z, q, c0, W]
-                        for r in range(m):
-                            X[e, row, W, r] = lw * Bt[c0, r]
-                        for c in range(c0 + 1, 6):
-                            lw = L[e, z, q, c, W]
-                            for r in range(m):
-                                X[e, row, W, r] += lw * Bt[c, r]
-            # internal force from the tied stresses at the tying points: f = Σ σ_ct B_ct
-            for c in range(6):
-                for t in range(nt[c]):
-                    v = sig[c, t]
-                    for r in range(m):
-                        f[e, r] += v * Bc[c, t, r]
-            if want_geo:
-                for p in range(P):
-                    for r in range(ndir[p]):
-                        K = dirs[p, r]
+                    for k2 in range(nT):
+                        s += Lh[e, z, k, k2] * Ek[k2]
+                    sig[k] = s
+            # f_a = Σ_k σ_k B_k = Σ_p Σ_K GS_K g_K with GS_K = Σ_J ∂_J phi σ_JK (the geometric
+            # operand), per tied direction and without the rows: the same arithmetic with and
+            # without the tangent (the residual of a line search equals that of the Newton step)
+            for p in range(P):
+                for r in range(ndir[p]):
+                    K = dirs[p, r]
+                    g0, g1, g2 = gg[p, K, 0], gg[p, K, 1], gg[p, K, 2]
+                    v = sig[gk[p, r, 0]]
+                    J = gJ[p, r, 0]
+                    for a in range(na):
+                        gsa[a] = v * dphi[p, J, a]
+                    for h in range(1, gn[p, r]):
+                        v = sig[gk[p, r, h]]
+                        J = gJ[p, r, h]
                         for a in range(na):
-                            GS[e, a, col] = 0.0
-                            GT[e, a, col] = dphi[p, a, K]
-                        for c in range(6):  # Σ_J dphi_J σ_JK over the components tied at p
-                            i, j = pi[c], pj[c]
-                            if i != K and j != K:
-                                continue
-                            J = j if i == K else i
-                            for t in range(nt[c]):
-                                if pts[c, t] == p:
-                                    v = sig[c, t]
-                                    for a in range(na):
-                                        GS[e, a, col] += v * dphi[p, a, J]
+                            gsa[a] += v * dphi[p, J, a]
+                    for a in range(na):
+                        ft[0, a] += gsa[a] * g0
+                        ft[1, a] += gsa[a] * g1
+                        ft[2, a] += gsa[a] * g2
+                    if want_geo:
+                        for a in range(na):
+                            GS[e, col, a] = gsa[a]
+                            GT[e, col, a] = dphi[p, K, a]
                         col += 1
+        for a in range(na):
+            f[e, 3 * a], f[e, 3 * a + 1], f[e, 3 * a + 2] = ft[0, a], ft[1, a], ft[2, a]
