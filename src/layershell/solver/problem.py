@@ -76,9 +76,11 @@ class Problem:
     def restore(self, snap: dict) -> None:
         """Undo to a :meth:`snapshot`; rebuilds the constraint operator."""
         if self.interfaces is None:
+            changed = any(not np.array_equal(v, self.bonded[k]) for k, v in snap["bonded"].items())
             for k, v in snap["bonded"].items():
                 self.bonded[k] = v.copy()
-            self.rebuild_constraints()
+            if changed or self.op is None:  # the operator depends on the bond flags alone
+                self.rebuild_constraints()
             return
         self.interfaces.restore(self, snap["state"])
         self.interfaces.resolves = snap["resolves"]  # re-solutions so far in this load step
