@@ -6,6 +6,7 @@ tests/test_dcb.py (``displacement_controlled``).
     PYTHONPATH=src python benchmarks/dcb.py                 # 150, 200, 300 elements
     PYTHONPATH=src python benchmarks/dcb.py 200             # one mesh
     PYTHONPATH=src python benchmarks/dcb.py 300 --viscosity 1e-6   # with viscous regularisation
+    PYTHONPATH=src python benchmarks/dcb.py --arc 100 [600]  # force-loaded, arc length (max steps)
 
 Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
 the load at the opening δ = 8 mm (interpolated along the branch), the branch's range against
@@ -80,7 +81,42 @@ def order(h: list[float], f: list[float]) -> float:
     return p
 
 
+def arc_length(nx: int, max_steps: int) -> dict:
+    """The force-loaded DCB (the example's edge loads) traced by arc length with the dissipation
+    constraint, from the start through the peak and the propagation branch, at most
+    ``max_steps`` increments: steps, Newton iterations (all attempts), the iterations of the
+    attempts that failed and were cut (the step's total minus the accepted attempt's cannot be
+    separated from summary.json, so the count of cut increments is printed), CPU and wall time,
+    the peak and the last load and why the path ended."""
+    from helpers import run_example
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    r = run_example("dcb_cohesive", {"nx = 150": f"nx = {nx}",
+                                     "factors = [0.01, 0.02, 0.05,": f'control = "arc_length"\nn = 50\nmax_steps = {max_steps}\n#'})
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    st = r.summary["steps"]
+    P = np.array([s["probes"]["P"] for s in st])
+    e = r.summary["energy"]
+    return {"nx": nx, "steps": len(st), "iterations": sum(s["iterations"] for s in st),
+            "cut": sum(1 for s in st if s["bisections"]), "cpu": cpu, "wall": wall, "P_max": float(P.max()),
+            "P_end": float(P[-1]), "opening_end": float(T.opening(st[-1])), "converged": r.summary["converged"],
+            "balance": e["balance_error"], "message": (r.message or "")[:160]}
+
+
 def main(argv: list[str]) -> None:
+    if "--arc" in argv:  # python benchmarks/dcb.py --arc 100 [max_steps]
+        i = argv.index("--arc")
+        nx = int(argv[i + 1])
+        max_steps = int(argv[i + 2]) if len(argv) > i + 2 else 600
+        os.environ.setdefault("LAYERSHELL_THREADS", "1")
+        m = arc_length(nx, max_steps)
+        print("| elements | steps | iterations | increments cut | CPU (s) | wall (s) | P_max (N) | last P (N) | "
+              "last opening (mm) | energy balance | end |")
+        print("|---|---|---|---|---|---|---|---|---|---|---|")
+        print(f"| {nx} | {m['steps']} | {m['iterations']} | {m['cut']} | {m['cpu']:.0f} | {m['wall']:.0f} | "
+              f"{m['P_max']:.2f} | {m['P_end']:.3g} | {m['opening_end']:.2f} | {100 * m['balance']:.2f} % | "
+              + ("complete" if m["converged"] else f"stopped: {m['message']}") + " |")
+        return
     viscosity = 0.0
     if "--viscosity" in argv:
         i = argv.index("--viscosity")
