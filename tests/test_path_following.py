@@ -434,3 +434,16 @@ def test_stagnation_detects_stalled_and_cycling_newton_only():
     assert first([1e3, 3e2, 2e1, 1e-1, 1e-5, 1e-12]) is None
     assert first([1.0, 5.0, 3.0, 0.5, 1e-3, 1e-8]) is None  # grows first, then converges
     assert first([2566.0] * 10, 0) is None  # off
+
+
+def test_complete_failure_needs_a_dissipating_increment():
+    """The path ends by complete failure where λ falls below end_fraction of its peak in an
+    increment that dissipates; elastic unloading to λ ≈ 0 (ΔG at round-off, here ±1e-15 of the
+    energy dissipated so far) does not end it, nor does a rising or still large load."""
+    from layershell.solver.arclength import complete_failure
+
+    assert complete_failure(1e-4, -0.01, 0.6, 0.02, 10.0, 1e-3)
+    assert not complete_failure(1e-4, -0.01, 0.6, 1e-14, 10.0, 1e-3)
+    assert not complete_failure(1e-4, -0.01, 0.6, -1e-14, 10.0, 1e-3)
+    assert not complete_failure(1e-4, +0.01, 0.6, 0.02, 10.0, 1e-3)
+    assert not complete_failure(0.3, -0.01, 0.6, 0.02, 10.0, 1e-3)

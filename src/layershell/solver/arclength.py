@@ -52,7 +52,7 @@ class PathSettings:
     increment: float = 0.1  # first Δλ (load control); arc length: sets the first arc length
     increment_max: float | None = None  # default 10 × increment (load control)
     arc_length: float | None = None  # first Δl; default: ‖Δu_r‖ of the linear predictor for ``increment``
-    arc_length_min: float | None = None  # default arc_length / 1000
+    arc_length_min: float | None = None  # default arc_length × 1e-6
     arc_length_max: float | None = None  # default 10 × arc_length
     psi: float = 0.0
     dissipation: bool = True
@@ -351,7 +351,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.arc_length = st.size = ps.arc_length if ps.arc_length is not None else _first_arc_length(problem, u, s, ps)
             st.arc_length0 = st.arc_length
     l0 = st.arc_length0
-    dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 / 1000.0
+    # the smallest arc length: far below the first (a cohesive crack front passing a node needs
+    # increments 10⁻⁴-10⁻⁵ of it; with 10⁻³ the 100-element DCB stopped at δ = 8.65 mm, with
+    # 10⁻⁶ it goes on to 15.9 mm); cutting also ends after max_cuts halvings
+    dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 * 1e-6
     dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * l0
     inc_max = ps.increment_max if ps.increment_max is not None else 10.0 * ps.increment
     # the smallest Δλ: well below what max_cuts halvings of the first increment reach, since the
@@ -424,7 +427,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if snap is not None:
                 problem.restore(snap)
             if st.mode == "dissipation" and msg.startswith("no dissipation"):
-                st.mode, st.size = "arc", st.arc_length  # elastic branch: back to the arc length
+                # elastic branch: back to the arc length, its direction by the work criterion -
+                # the previous direction (a snap-back: load and displacement falling while the
+                # crack grew) would now follow elastic unloading down to λ = 0 (the DCB on 100
+                # elements: 50 % of its interface debonded, then unloaded and "failed")
+                st.mode, st.size, st.changed = "arc", st.arc_length, True
                 continue
             if st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0:
                 # e.g. at a peak where damage starts: the arc length cannot pick the branch, the
@@ -488,7 +495,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
         else:
             st.finished = (to_end or lam >= end
-                           or (st.lam_peak > 0 and dlam < 0 and lam <= ps.end_fraction * st.lam_peak))
+                           or complete_failure(lam, dlam, st.lam_peak, dG, st.dissipated, ps.end_fraction))
         end_reason = None
         if st.finished:
             end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
@@ -503,6 +510,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         yield res
         if st.finished:
             return
+
+
+def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissipated: float,
+                     end_fraction: float) -> bool:
+    """Does an accepted increment end the path by complete failure? λ fell (Δλ < 0) below
+    ``end_fraction`` of its peak in an increment that dissipated energy: not elastic unloading
+    (ΔG at round-off), which can take λ to 0 as well - the DCB on 100 elements, half its
+    interface debonded, unloaded along its secant and was reported as failed."""
+    return (lam_peak > 0 and dlam < 0 and lam <= end_fraction * lam_peak
+            and dG > 1e-9 * max(dissipated, 1e-300))
 
 
 def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -> float:
