@@ -403,7 +403,7 @@ class Steps(Strict):
         "independent DOFs (length units; default: that of the linear predictor for Δλ = lambda_end/n)")
     arc_length_min: PositiveFloat | None = Field(
         None, description="control = 'arc_length': the smallest arc length before the run stops (default "
-        "arc_length × 10⁻⁶: increments that fail are cut until then or until max_cuts)")
+        "arc_length/1000)")
     arc_length_max: PositiveFloat | None = Field(
         None, description="control = 'arc_length': the largest arc length (default 10 × arc_length); "
         "it also bounds the increments under the dissipation constraint (the next dissipation increment is "

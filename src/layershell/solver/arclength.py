@@ -52,7 +52,7 @@ class PathSettings:
     increment: float = 0.1  # first Δλ (load control); arc length: sets the first arc length
     increment_max: float | None = None  # default 10 × increment (load control)
     arc_length: float | None = None  # first Δl; default: ‖Δu_r‖ of the linear predictor for ``increment``
-    arc_length_min: float | None = None  # default arc_length × 1e-6
+    arc_length_min: float | None = None  # default arc_length / 1000
     arc_length_max: float | None = None  # default 10 × arc_length
     psi: float = 0.0
     dissipation: bool = True
@@ -351,10 +351,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.arc_length = st.size = ps.arc_length if ps.arc_length is not None else _first_arc_length(problem, u, s, ps)
             st.arc_length0 = st.arc_length
     l0 = st.arc_length0
-    # the smallest arc length: far below the first (a cohesive crack front passing a node needs
-    # increments 10⁻⁴-10⁻⁵ of it; with 10⁻³ the 100-element DCB stopped at δ = 8.65 mm, with
-    # 10⁻⁶ it goes on to 15.9 mm); cutting also ends after max_cuts halvings
-    dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 * 1e-6
+    # the smallest arc length (a user setting: the 100-element DCB stops at δ = 8.65 mm with this
+    # default and goes on to δ = 15.9 mm with arc_length_min = 1e-7, 1.3·10⁻⁷ of the first; with
+    # 10⁻⁶ or 10⁻⁹ of the first as the default it still stopped at 8.65 mm)
+    dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 / 1000.0
     dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * l0
     inc_max = ps.increment_max if ps.increment_max is not None else 10.0 * ps.increment
     # the smallest Δλ: well below what max_cuts halvings of the first increment reach, since the
