@@ -224,6 +224,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     Fc_r = op.reduce(problem.F_const)
     solver = problem.linear_solver(s.backend)
     start = att.iterations
+    first = len(att.residuals)  # this call's residuals: att.residuals[first:]
     for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
@@ -240,7 +241,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             return dur, dlam, True
         if it == max_iterations:
             break
-        if stagnates(att.residuals[len(att.residuals) - it - 1:], stagnation):
+        if stagnates(att.residuals[first:], stagnation):
             att.message = f"no progress in the last {stagnation} of {it} iterations (residual {rn:.3e})"
             return dur, dlam, False
         try:

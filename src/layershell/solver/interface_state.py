@@ -377,11 +377,8 @@ class InterfaceController:
         runs = {k.split(".")[0] for k in state if k.startswith("run")}
         if len(runs) != len(self.runs):
             raise ValueError(f"the saved state has {len(runs)} interface(s) with a law, this model {len(self.runs)}")
-        changed = False
         for k in problem.bonded:
-            flags = take(f"bonded.{k}", problem.bonded[k])
-            changed = changed or not np.array_equal(flags, problem.bonded[k])
-            problem.bonded[k] = flags
+            problem.bonded[k] = take(f"bonded.{k}", problem.bonded[k])
         self.lam = float(take("lam", None))
         for i, r in enumerate(self.runs):
             for name in self._run_arrays(r):
@@ -401,8 +398,7 @@ class InterfaceController:
             self.u_last = np.array(state["energy.u"]) if "energy.u" in state else None
             self.f_last = np.array(state["energy.f"]) if "energy.f" in state else None
         self.resolves = 0
-        if changed or problem.op is None:  # the operator depends on the bond flags alone: a new
-            problem.rebuild_constraints()  # one costs its reduced assembly map and a new analysis
+        problem.rebuild_constraints()
         self.sync(problem)
 
     # ------------------------------------------------------------------ results
