@@ -285,3 +285,26 @@ def test_active_set_loop_accepts_a_cycling_state_only_within_the_tolerance():
         assert pb.accepted_sets == int(accepted) and pb.accepted_violation == (v if accepted else 0.0)
         b.v = 0.0
         assert loop.consistent(None, "exact")
+
+
+def test_round_off_floor_is_accepted_whatever_the_step_size():
+    """The round-off floor test of Newton (solver/newton.py, at_round_off_floor) measures the
+    energy of a correction against the larger of the first correction's energy and the work
+    f·u of the state. Against the first correction alone it depended on the step size: a tiny
+    (bisected) step has a tiny first correction, and the cohesive §5.1 plate (MITC9, 12 × 12)
+    stalled at 1.1·10⁻⁸ > 10⁻⁸ with |Δu·r| ~ 10⁻²³ through all its bisections. Here only the
+    energy test may end the iterations (residual and displacement tolerances off): a full step
+    and a step of 10⁻⁹ of the load both stop at the floor within a few iterations; with the
+    first correction as the scale the small step would run to max_iterations."""
+    from dataclasses import replace
+
+    from layershell.solver.newton import NewtonSettings, newton_fixed_set
+
+    spec = strip(nonlinear="true", nx=4, load="1.0", cohesive={})
+    pb = Problem.build(spec.model)
+    s = replace(NewtonSettings(), tol_residual=0.0, tol_displacement=0.0, line_search=False)
+    u1, r1 = newton_fixed_set(pb, np.zeros(pb.dm.n_full), 1.0, s)
+    assert r1.converged and "floor" in r1.message and r1.iterations <= 8
+    u2, r2 = newton_fixed_set(pb, u1, 1.0 + 1e-9, s)
+    assert r2.converged and "floor" in r2.message and r2.iterations <= 8
+    assert np.abs(u2 - u1).max() == pytest.approx(1e-9 * np.abs(u1).max(), rel=0.5)  # the step's response

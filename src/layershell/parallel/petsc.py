@@ -31,7 +31,7 @@ from ..dofs import number_dofs
 from ..loads import external_forces
 from ..model import Model
 from ..solver import linear
-from ..solver.newton import ConvergenceError, DebondCut, NewtonResult, NewtonSettings
+from ..solver.newton import ConvergenceError, DebondCut, NewtonResult, NewtonSettings, at_round_off_floor
 from ..solver.newton import load_steps as serial_load_steps
 from ..solver.problem import Problem
 from .partition import LocalAssembly, element_ranges, element_weights, interface_rows
@@ -374,9 +374,8 @@ class DistributedProblem:
             en = abs(float(self.x.dot(self.b)))
             e0 = en if e0 is None else e0
             dU = self.op.expand(du)
-            if (it > 0 and rn <= s.tol_floor * scale
-                    and (en <= s.tol_energy * e0
-                         or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300))):
+            work = abs(float((lam * self.F_scaled + self.F_const) @ u))  # λF·u: the external work scale
+            if it > 0 and at_round_off_floor(rn, scale, en, max(e0, work), dU, u, s):
                 res.converged, res.iterations = True, it
                 res.message = "converged at the round-off floor"
                 return u + dU, res
