@@ -314,6 +314,15 @@ def test_tied_strain_at_points_equals_the_kernel_strain(rng):
         got = mitc.tied_strain(np.repeat(X, 9, 0), np.repeat(Hb, 9, 0), np.repeat(H, 9, 0), d,
                                np.repeat(U, 9, 0), gp[:, 0].copy(), gp[:, 1].copy(), thL)
         assert np.allclose(got, want[z], rtol=1e-10, atol=1e-12 * np.abs(want).max())
+        # the points of one element at one level share the strains at the tying points (groups):
+        # the same values, with those of a second element (other displacements) in the same call
+        U2 = U + 0.03 * rng.standard_normal(U.shape)
+        both = mitc.tied_strain(np.repeat(X, 18, 0), np.repeat(Hb, 18, 0), np.repeat(H, 18, 0), d,
+                                np.concatenate([np.repeat(U, 9, 0), np.repeat(U2, 9, 0)]), np.tile(gp[:, 0], 2),
+                                np.tile(gp[:, 1], 2), np.tile(thL, 2), groups=np.repeat([0, 1], 9))
+        other = mitc.tied_strain(np.repeat(X, 9, 0), np.repeat(Hb, 9, 0), np.repeat(H, 9, 0), d,
+                                 np.repeat(U2, 9, 0), gp[:, 0].copy(), gp[:, 1].copy(), thL)
+        assert np.array_equal(both[:9], got) and np.array_equal(both[9:], other)
 
 
 @pytest.mark.slow

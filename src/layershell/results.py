@@ -128,7 +128,7 @@ def evaluate_points(
             from .element.mitc import tied_strain
 
             Ev = tied_strain(model.mesh.nodes[conn], model.offset(k)[conn], ly.thickness[conn], ly.directors, U,
-                             xi[sel], eta[sel], thL, model.nonlinear)
+                             xi[sel], eta[sel], thL, model.nonlinear, groups=elements[sel])
         else:
             Ev = green_lagrange(Hg, model.nonlinear)
         M = material_frame(sp, ly.angle, ly.direction)[:, 0]
