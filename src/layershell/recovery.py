@@ -466,15 +466,14 @@ class Recovery:
                 zl = levels(ly.directors)
                 nl = zl.size
                 H = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
-                Sk = _sym(f.S[k][conn[sel]])  # (p, 9, nl, 3, 3)
-                Skt = np.einsum("pia,pnlij,pjb->pnlab", T[sel], Sk, T[sel], optimize=True)  # tangent frame
+                S_at = _sym(np.einsum("pn,pnlv->plv", spq.N[sel, 0], f.S[k][conn[sel]]))  # (p, nl, 3, 3)
                 # D_α = ∂σ_αβ/∂s_β (p, nl, 2) interpolated from its nodal values (second pass): the
                 # derivative of the interpolated nodal stress at the point itself depends on the
                 # element at its nodes and converged only at first order (+4.7/+2.3/+1.1 % of the
                 # interface shear of benchmarks/vs_solid.py's plate at a node on 8/16/32 elements)
                 Da = np.einsum("pn,pnli,pia->pla", spq.N[sel, 0], f.D[k][conn[sel]], T[sel])
                 Ev = np.einsum("pai,pali->pl", gradN[sel], f.D[k][conn[sel]])  # ∂D_β/∂s_β (p, nl)
-                Sin = np.einsum("pn,pnlab->plab", spq.N[sel, 0], Skt)  # (p, nl, 2, 2)
+                Sin = np.einsum("pia,plij,pjb->plab", T[sel], S_at, T[sel], optimize=True)  # (p, nl, 2, 2), tangent frame
                 Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
 
                 def G_at(s):  # G = μ F - K at layer fractions s (p, q)
