@@ -68,18 +68,24 @@ def test_patch_recovery_reproduces_complete_polynomials(patch, degree):
     assert np.abs(R @ f(X) - f(mesh.nodes)).max() < 1e-11
 
 
+def _rectangle_with_two_symmetry_planes() -> Model:
+    """One ply on an 8 × 6 mesh of [0, 2] × [0, 1] with symmetry planes x = 2 and y = 0."""
+    mesh = rectangle(2.0, 1.0, 8, 6)
+    x = mesh.nodes
+    sym = [Symmetry(np.flatnonzero(np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0])),
+           Symmetry(np.flatnonzero(np.isclose(x[:, 1], 0.0)), np.array([0, -1.0, 0]))]
+    return Model(mesh, [Layer("a", PLY, 1, np.full(mesh.n_nodes, 0.1))], [(0,)], np.zeros(mesh.n_elements, int),
+                 symmetries=sym)
+
+
 def test_patch_recovery_at_symmetry_planes_mirrors_the_field():
     """Nodes on symmetry planes (x = 2 and y = 0 here) fit their patch completed by its mirror
     images: a field even about both planes and one odd about x = 2 (even about y = 0) are
     recovered exactly at every node, including the corner on both planes."""
     from layershell.recovery import Recovery
 
-    mesh = rectangle(2.0, 1.0, 8, 6)
-    x = mesh.nodes
-    sym = [Symmetry(np.flatnonzero(np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0])),
-           Symmetry(np.flatnonzero(np.isclose(x[:, 1], 0.0)), np.array([0, -1.0, 0]))]
-    m = Model(mesh, [Layer("a", PLY, 1, np.full(mesh.n_nodes, 0.1))], [(0,)], np.zeros(mesh.n_elements, int),
-              symmetries=sym)
+    m = _rectangle_with_two_symmetry_planes()
+    mesh, x = m.mesh, m.mesh.nodes
     rec = Recovery.__new__(Recovery)
     Recovery.__init__(rec, m, None)
     assert set(rec.R[0]) == {0, 1, 2, 3}
@@ -101,12 +107,8 @@ def test_edge_nodes_are_the_boundary_off_symmetry_planes():
     nodes on x = 0 and y = 1 (the corners (2, 1) and (0, 0) included: they end such an edge)."""
     from layershell.recovery import edge_nodes, symmetry_axes
 
-    mesh = rectangle(2.0, 1.0, 8, 6)
-    x = mesh.nodes
-    sym = [Symmetry(np.flatnonzero(np.isclose(x[:, 0], 2.0)), np.array([1.0, 0, 0])),
-           Symmetry(np.flatnonzero(np.isclose(x[:, 1], 0.0)), np.array([0, -1.0, 0]))]
-    m = Model(mesh, [Layer("a", PLY, 1, np.full(mesh.n_nodes, 0.1))], [(0,)], np.zeros(mesh.n_elements, int),
-              symmetries=sym)
+    m = _rectangle_with_two_symmetry_planes()
+    mesh, x = m.mesh, m.mesh.nodes
     got = edge_nodes(m, symmetry_axes(m))
     want = np.flatnonzero(np.isclose(x[:, 0], 0.0) | np.isclose(x[:, 1], 1.0))
     assert np.array_equal(np.sort(got), want)
