@@ -375,7 +375,8 @@ class DistributedProblem:
             e0 = en if e0 is None else e0
             dU = self.op.expand(du)
             work = abs(float((lam * self.F_scaled + self.F_const) @ u))  # λF·u: the external work scale
-            if it > 0 and at_round_off_floor(rn, scale, en, max(e0, work), dU, u, s):
+            stalled = it > 1 and rn > 0.5 * res.residuals[-2]
+            if it > 0 and at_round_off_floor(rn, scale, en, e0, dU, u, s, work, stalled):
                 res.converged, res.iterations = True, it
                 res.message = "converged at the round-off floor"
                 return u + dU, res
