@@ -354,7 +354,17 @@ class Recovery:
                 keep = sp.diags((axes == 0).astype(float))
                 R = {g: Rm.get(g, 0) + (keep @ R[0] if g == 0 else 0) for g in Rm}
             self.R[k] = R
-        self._edge = edge_nodes(model, axes)  # boundary nodes (not on symmetry planes)
+        # geometry per layer, built once: its elements and their Gauss points; for the boundary
+        # nodes off symmetry planes (edge_nodes) the elements at them and their nodal positions
+        self._edge = edge_nodes(model, axes)
+        pts, _ = gauss_2d(n_gauss)
+        E = model.mesh.elements
+        self._geometry = {}
+        for k in range(len(model.layers)):
+            els = np.flatnonzero([k in model.stacks[s] for s in model.element_stack])
+            at_edge = els[np.isin(E[els], self._edge).any(axis=1)]
+            spn = surface_points(model.mesh.nodes[E[at_edge]], NODE_XI[:, 0], NODE_XI[:, 1]) if at_edge.size else None
+            self._geometry[k] = (els, surface_points(model.mesh.nodes[E[els]], pts[:, 0], pts[:, 1]), at_edge, spn)
         self._cache: tuple | None = None
 
     # -- nodal fields -------------------------------------------------------------------
@@ -368,14 +378,13 @@ class Recovery:
         ng = len(pts)
         S, D = {}, {}
         for k, ly in enumerate(m.layers):
-            els = np.flatnonzero([k in m.stacks[s] for s in m.element_stack])
+            els, spg, _, _ = self._geometry[k]
             z = levels(ly.directors)
             nl = z.size
             e_all = np.repeat(els, ng * nl)
             xi = np.tile(np.repeat(pts[:, 0], nl), els.size)
             eta = np.tile(np.repeat(pts[:, 1], nl), els.size)
-            H = surface_points(m.mesh.nodes[m.mesh.elements[els]], pts[:, 0], pts[:, 1]).interpolate(
-                ly.thickness[m.mesh.elements[els]])  # (e, g)
+            H = spg.interpolate(ly.thickness[m.mesh.elements[els]])  # (e, g)
             th = (H[:, :, None] * z).ravel()
             ps = evaluate_points(m, self.dm, u, e_all, xi, eta, th, np.full(e_all.size, k), local_theta=True)
             vals = np.zeros((ne, ng, nl, 6))
@@ -389,21 +398,19 @@ class Recovery:
         # (edge shear 0.2 % → 1.4 % on the quarter plate).
         E = m.mesh.elements
         for k in S:
-            els = np.flatnonzero([k in m.stacks[s] for s in m.element_stack])
-            Xe = m.mesh.nodes[E[els]]
-            Sk = _sym(S[k][E[els]])  # (e, 9 nodes, nl, 3, 3)
+            els, spg, at_edge, spn = self._geometry[k]
             Dv = np.zeros((ne, ng) + S[k].shape[1:2] + (3,))
-            Dv[els] = _divergence(surface_points(Xe, pts[:, 0], pts[:, 1]), Sk)
+            Dv[els] = _divergence(spg, _sym(S[k][E[els]]))
             D[k] = self._apply(k, Dv.reshape(ne * ng, -1, 3), ((0,), (1,), (2,)))
-            if self._edge.size:
+            if at_edge.size:
                 # boundary nodes: a one-sided fit of D extrapolates the derivative samples (0.5 %
                 # at the simply supported edges of the [0/90/0] plate); the derivative of the
                 # smoothed stress at the node itself, averaged over its elements, keeps them at 0.05 %
-                Dn = _divergence(surface_points(Xe, NODE_XI[:, 0], NODE_XI[:, 1]), Sk)  # (e, 9 positions, nl, 3)
+                Dn = _divergence(spn, _sym(S[k][E[at_edge]]))  # (e, 9 positions, nl, 3)
                 acc = np.zeros(D[k].shape)
                 cnt = np.zeros(m.mesh.n_nodes)
-                np.add.at(acc, E[els].ravel(), Dn.reshape((-1,) + Dn.shape[2:]))
-                np.add.at(cnt, E[els].ravel(), 1.0)
+                np.add.at(acc, E[at_edge].ravel(), Dn.reshape((-1,) + Dn.shape[2:]))
+                np.add.at(cnt, E[at_edge].ravel(), 1.0)
                 b = self._edge[cnt[self._edge] > 0]
                 D[k][b] = acc[b] / cnt[b, None, None]
         out = RecoveryFields(S, D)

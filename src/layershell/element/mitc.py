@@ -491,8 +491,7 @@ def tied_strain(X: np.ndarray, H_below: np.ndarray, H: np.ndarray, d: int, U: np
         _, rows, inv = np.unique(np.stack([np.asarray(groups, float), zeta[:, 0, 0]], -1), axis=0,
                                  return_index=True, return_inverse=True)
         inv = inv.ravel()
-    pts = np.concatenate([tie.points[:16], np.zeros((1, 2))])  # ties (+ a placeholder point)
-    Ffr, M, _, _, _, _, thp = strain_frames(X[rows], H_below[rows], H[rows], pts, zeta[rows], frame)
+    Ffr, M, _, _, _, _, thp = strain_frames(X[rows], H_below[rows], H[rows], tie.points[:16], zeta[rows], frame)
     N, dN, _ = _quad9(tie.points[:16])
     Ev_tie = _strains(Ffr[:, :16, 0], M[:, :16, 0], thp[:, :16, 0], np.broadcast_to(N, (rows.size,) + N.shape),
                       np.broadcast_to(dN, (rows.size,) + dN.shape), U[rows], d, nonlinear)  # (u, 16, 6)

@@ -374,9 +374,8 @@ class DistributedProblem:
             en = abs(float(self.x.dot(self.b)))
             e0 = en if e0 is None else e0
             dU = self.op.expand(du)
-            work = abs(float((lam * self.F_scaled + self.F_const) @ u))  # λF·u: the external work scale
-            stalled = it > 1 and rn > 0.5 * res.residuals[-2]
-            if it > 0 and at_round_off_floor(rn, scale, en, e0, dU, u, s, work, stalled):
+            work = lambda: abs(float((lam * self.F_scaled + self.F_const) @ u))  # noqa: E731  λF·u, the work scale
+            if it > 0 and at_round_off_floor(res.residuals, scale, en, e0, dU, u, s, work):
                 res.converged, res.iterations = True, it
                 res.message = "converged at the round-off floor"
                 return u + dU, res

@@ -346,8 +346,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
         dU = op.expand(du)
         en = abs(float(du @ r))
         e0 = en if e0 is None else e0
-        stalled = it > 1 and rn > 0.5 * res.residuals[-2]
-        if it > 0 and at_round_off_floor(rn, scale, en, e0, dU, u, s, abs(float(f @ u)), stalled):
+        if it > 0 and at_round_off_floor(res.residuals, scale, en, e0, dU, u, s, lambda: abs(float(f @ u))):
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
             _record_scale(problem, scale)
@@ -363,17 +362,21 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     return u, res
 
 
-def at_round_off_floor(rn: float, scale: float, en: float, e0: float, dU: np.ndarray, u: np.ndarray,
-                       s: NewtonSettings, work: float = 0.0, stalled: bool = False) -> bool:
-    """The round-off floor test of the Newton iterations (module docstring): a residual within
-    ``tol_floor`` with a negligible correction - its energy ``en`` = |Δu·r| within ``tol_energy``
-    of the first correction's ``e0``, or, once the residual has ``stalled`` (not halved by the
-    last iteration), of the ``work`` f·u of the state; or its size within ``tol_displacement`` of
-    the displacements. (The work alone would end iterations that still converge: with a
-    tolerance of 10⁻¹² the Gmsh plate and its generator twin then differed by 9·10⁻⁸.)"""
-    return rn <= s.tol_floor * scale and (
-        en <= s.tol_energy * e0 or (stalled and en <= s.tol_energy * work)
-        or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300))
+def at_round_off_floor(residuals: list[float], scale: float, en: float, e0: float, dU: np.ndarray, u: np.ndarray,
+                       s: NewtonSettings, work: Callable[[], float]) -> bool:
+    """The round-off floor test of the Newton iterations (module docstring): the last of the
+    ``residuals`` within ``tol_floor`` with a negligible correction - its energy ``en`` = |Δu·r|
+    within ``tol_energy`` of the first correction's ``e0``, or, once the residual has stalled (not
+    halved by the last iteration), of the work f·u of the state (``work()``, evaluated only then);
+    or its size within ``tol_displacement`` of the displacements. (The work alone would end
+    iterations that still converge: with a tolerance of 10⁻¹² the Gmsh plate and its generator
+    twin then differed by 9·10⁻⁸.)"""
+    rn = residuals[-1]
+    if rn > s.tol_floor * scale:
+        return False
+    if en <= s.tol_energy * e0 or np.abs(dU).max() <= s.tol_displacement * max(np.abs(u).max(), 1e-300):
+        return True
+    return len(residuals) > 2 and rn > 0.5 * residuals[-2] and en <= s.tol_energy * work()
 
 
 def _record_scale(problem: Problem, scale: float) -> None:
