@@ -54,3 +54,68 @@ def test_first_full_debonding_converges_with_the_mesh():
     f6, f12 = coarse["first_delamination_load_factor"], fine["first_delamination_load_factor"]
     assert abs(f12 - f6) / f12 < 0.03
     assert fine["first_damage_load_factor"] < 0.7 * coarse["first_damage_load_factor"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("mu0", [0.0, 0.95])
+def test_mitc9_plate_reaches_full_load_on_12_x_12(mu0):
+    """With the MITC9 element the 12 × 12 plate stalled at λ = 0.995, with (μ0 = 0.95, the
+    example) and without friction, where the TRC flap at the clamp debonds: a frozen-set solve
+    converged linearly to ~4·10⁻⁵ of the load and jumped away, through all 8 bisections (the
+    frozen problem has no solution there: its path turns back). Freezing the sets again where a
+    failed solve left them (solver/newton.py ``MAX_REFREEZE``) takes it to λ = 1. The front
+    deflection then agrees with 6 × 6 (0.05932 m; measured 0.05988 m on 12 × 12 with and
+    without friction: 0.9 %) and with the fully integrated element's 12 × 12 (0.05958 m, 0.5 %)
+    within 3 %, and the energy balance closes. About 1 (μ0 = 0) and 4 (μ0 = 0.95) CPU minutes."""
+    edits = {'element = "full"': 'element = "mitc"', "mu0 = 0.95": f"mu0 = {mu0}"}
+    runs = {n: run_example("cantilever_plate_cohesive", {**edits, "nx = 6": f"nx = {n}", "ny = 6": f"ny = {n}"}).summary
+            for n in (6, 12)}
+    for s in runs.values():
+        assert s["converged"] and s["steps"][-1]["load_factor"] == 1.0
+        assert abs(s["energy"]["balance_error"]) < 0.01
+    w6, w12 = runs[6]["probes"]["w_front_max"], runs[12]["probes"]["w_front_max"]
+    assert abs(w12 - w6) / w12 < 0.03
+    assert abs(w12 - 0.05958) / 0.05958 < 0.03
+
+
+def test_arc_length_on_the_mitc9_plate_goes_forward():
+    """Arc length on the cohesive plate with MITC9 (6 × 6, μ0 = 0, four increments). The arc
+    length is measured in length units (solver/arclength.py ``arc_weights``: each director
+    coefficient u_l times t^l). In the plain DOF norm the cubic director of the 10 mm TRC layer
+    made up 99.97 % of an increment (on 12 × 12), so the constraint held that layer's thickness
+    change instead of the deflection: the second increment converged at λ = -0.39 with the same
+    Δu as the predictor (12 × 12), or (6 × 6, with the round-off floor of the iterations missing
+    as well) the first increments stalled at 2·10⁻⁸ and the dissipation constraint went to
+    λ = -25. Now every increment raises λ, and damage starts on the way."""
+    import numpy as np
+
+    s = run_example("cantilever_plate_cohesive", {
+        'element = "full"': 'element = "mitc"', "mu0 = 0.95": "mu0 = 0.0",
+        "[steps]\nn = 24": '[steps]\nn = 24\ncontrol = "arc_length"\nmax_steps = 4'}).summary
+    lam = np.array([st["load_factor"] for st in s["steps"]])
+    assert len(lam) == 4 and np.all(np.diff(np.concatenate([[0.0], lam])) > 0)
+    assert lam[0] == pytest.approx(1 / 24, rel=1e-3)  # the first increment: the linear predictor's
+    assert s["first_damage_load_factor"] < lam[-1]
+
+
+def test_arc_weights_are_lengths():
+    """``full_weights``: t^l per DOF of director l (t the layer's thickness at the node); with
+    them an increment of the director coefficients is measured by how far it moves the layer's
+    far face."""
+    import numpy as np
+
+    from layershell.io.build import build, parse
+    from layershell.solver.arclength import arc_weights, full_weights
+    from layershell.solver.problem import Problem
+
+    from helpers import EXAMPLES
+
+    path = EXAMPLES / "cantilever_plate_cohesive.toml"
+    pb = Problem.build(build(parse(path.read_text(), str(path)), path.parent).model)
+    w = full_weights(pb)
+    for ld, ly in zip(pb.dm.layer_dofs, pb.model.layers):
+        t = np.broadcast_to(np.asarray(ly.thickness, float), (ld.shape[0],))
+        for l in range(ld.shape[1]):
+            ok = ld[:, l, 0] >= 0
+            assert np.allclose(w[ld[ok, l, :]], (t[ok] ** l)[:, None])
+    assert np.array_equal(arc_weights(pb), w[pb.op.independent])

@@ -400,7 +400,8 @@ class Steps(Strict):
         None, description="adaptive load control: the largest load-factor increment (default 10 × lambda_end/n)")
     arc_length: PositiveFloat | None = Field(
         None, description="control = 'arc_length': the first arc length, the norm of the increment of the "
-        "independent DOFs (length units; default: that of the linear predictor for Δλ = lambda_end/n)")
+        "independent DOFs in length units (each director coefficient u_l times t^l, t the layer's thickness: "
+        "how far it moves the layer's far face; default: that of the linear predictor for Δλ = lambda_end/n)")
     arc_length_min: PositiveFloat | None = Field(
         None, description="control = 'arc_length': the smallest arc length before the run stops (default "
         "arc_length/1000)")

@@ -35,7 +35,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, newton, stagnates
+from .newton import (ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
+                     newton, stagnates)
 from .problem import Problem
 
 
@@ -168,8 +169,10 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         return _unfrozen(att, blocks)
     dUt = op.expand(dut)
     if mode == "arc":
-        dlam = size / math.sqrt(float(dut @ dut) + ps.psi**2 * qq)
-        if (float(du_prev @ dUt) if du_prev is not None else float(q @ dut)) < 0.0:
+        wt = dut * arc_weights(problem)
+        dlam = size / math.sqrt(float(wt @ wt) + ps.psi**2 * qq)
+        wf = full_weights(problem)
+        if (float((du_prev * wf) @ (dUt * wf)) if du_prev is not None else float(q @ dut)) < 0.0:
             dlam = -dlam
     else:
         F = problem.F_scaled
@@ -179,6 +182,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             return _unfrozen(att, blocks)
         dlam = size / den
     dur = dlam * dut
+    predictor = dur.copy()
+    wr = arc_weights(problem)
     for k in range(s.max_active_set_loops if blocks else 1):
         if k > 0 and not loop.freeze(att.u):
             att.message = "the cohesive loading set cycles (no consistent set near this increment)"
@@ -189,6 +194,12 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
                                                 s.stagnation_iterations if blocks else 0)
         if not ok:
             return _unfrozen(att, blocks, loop, problem)
+        if mode == "arc" and float((dur * wr) @ (predictor * wr)) < 0.0:
+            # the other intersection of the constraint with the path: where the sets change within
+            # the increment (the §5.1 plate as damage starts, MITC9 12 x 12) the iterations can
+            # cross to the point behind u0 - the path ran backwards through λ = 0 to λ = -0.39
+            att.message = "the increment turned back against its predictor (the other root of the arc length)"
+            return _unfrozen(att, blocks)
         if loop.consistent(att.u, (att.u, att.lam)):
             att.converged = True
             return _unfrozen(att, blocks, loop, problem)
@@ -225,6 +236,8 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     solver = problem.linear_solver(s.backend)
     start = att.iterations
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
+    e0: float | None = None
+    wr = arc_weights(problem)
     for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
@@ -251,11 +264,22 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             att.message = f"singular tangent ({exc})"
             return dur, dlam, False
         a, b = ab[:, 0], ab[:, 1]
+        # the round-off floor of the Newton iterations (at_round_off_floor): the equilibrium
+        # correction a carries the energy; a negligible one ends the iterations where the
+        # residual is within tol_floor (the §5.1 plate: 1.1e-8 of the load at λ = 0.04, MITC9)
+        en = abs(float(a @ r))
+        e0 = en if e0 is None else e0
+        if it > 0 and at_round_off_floor(att.residuals[first:], scale, en, e0, a, u, s,
+                                         lambda: abs(float(f @ u))):
+            att.message = "converged at the round-off floor"
+            return dur, dlam, True
         if mode == "arc":
             # ‖dur + a + δλ b‖² + ψ²(Δλ + δλ)² qq = Δl²  (Crisfield 1981)
             w = dur + a
-            A = float(b @ b) + ps.psi**2 * qq
-            B = 2.0 * float(w @ b) + 2.0 * ps.psi**2 * qq * dlam
+            # the increments in length units: each director's coefficient times t^l (arc_weights)
+            w, bw, dw = (dur + a) * wr, b * wr, dur * wr
+            A = float(bw @ bw) + ps.psi**2 * qq
+            B = 2.0 * float(w @ bw) + 2.0 * ps.psi**2 * qq * dlam
             C = float(w @ w) + ps.psi**2 * qq * dlam**2 - size**2
             disc = B * B - 4.0 * A * C
             if disc < 0.0:  # no intersection: the point of the line closest to the constraint
@@ -264,7 +288,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
                 sq = math.sqrt(disc)
                 roots = [(-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A)]
             # the root whose increment keeps the direction of the current one
-            dl = max(roots, key=lambda x: float((w + x * b) @ dur) + ps.psi**2 * qq * (dlam + x) * dlam)
+            dl = max(roots, key=lambda x: float((w + x * bw) @ dw) + ps.psi**2 * qq * (dlam + x) * dlam)
         else:
             # ½ F̂ᵀ(λ₀ (Δu + a + δλ b) − (Δλ + δλ) u₀) = Δτ  (linear in δλ)
             F = problem.F_scaled
@@ -417,7 +441,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         ok, msg = False, att.message
                         break
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
-                    and float((att.u - u) @ st.du_prev) < 0.0):
+                    and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
@@ -485,7 +509,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
         else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
             # down where this one was longer (else a short bond's peak lies inside one increment)
-            dun = float(np.linalg.norm(du[problem.op.independent]))
+            dun = float(np.linalg.norm(du[problem.op.independent] * arc_weights(problem)))
             st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
             st.arc_length = max(min(dun, dl_max), dl_min)
         st.du_prev = du
@@ -523,9 +547,39 @@ def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissip
             and dG > 1e-9 * max(dissipated, 1e-300))
 
 
+def full_weights(problem: Problem) -> np.ndarray:
+    """Per full-space DOF the length by which its coefficient moves its layer's far face: t^l
+    for director l of a layer of (nodal) thickness t (u = Σ (Θ³)^l u_l, 0 ≤ Θ³ ≤ t; MODEL.md
+    (2.17)), 1 for the displacements u_0 and for DOFs of no layer."""
+    w = np.ones(problem.dm.n_full)
+    for ld, ly in zip(problem.dm.layer_dofs, problem.model.layers):
+        t = np.broadcast_to(np.asarray(ly.thickness, float), (ld.shape[0],))
+        for l in range(1, ld.shape[1]):
+            idx = ld[:, l, :]
+            ok = idx >= 0
+            w[idx[ok]] = np.broadcast_to((t**l)[:, None], idx.shape)[ok]
+    return w
+
+
+def arc_weights(problem: Problem) -> np.ndarray:
+    """:func:`full_weights` of the reduced (independent) DOFs: the arc length and the sizes of
+    the path increments are measured in length units, ‖w ∘ Δu_r‖. The director coefficients
+    u_l carry 1/length^l: in the plain DOF norm the cubic director of the 10 mm TRC layer of the
+    §5.1 plate (MITC9, 12 × 12) made up 99.97 % of an increment, so the constraint controlled
+    that layer's thickness change instead of the plate's deflection, and the second increment
+    converged at λ = -0.39 from +0.04 with the same Δu. Cached per constraint operator."""
+    op = problem.op
+    cache = getattr(problem, "_arc_weights", None)
+    if cache is not None and cache[0] is op:
+        return cache[1]
+    wr = full_weights(problem)[op.independent]
+    problem._arc_weights = (op, wr)
+    return wr
+
+
 def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -> float:
     """A first Δτ: the elastic energy ½ λ F̂ᵀu times the relative size of the arc length."""
-    un = float(np.linalg.norm(u[problem.op.independent]))
+    un = float(np.linalg.norm(u[problem.op.independent] * arc_weights(problem)))
     return 0.5 * abs(lam * float(problem.F_scaled @ u)) * min(1.0, dl / max(un, 1e-300)) * 0.5
 
 
@@ -533,4 +587,4 @@ def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: Pa
     """‖δu_r‖ of the linear predictor for the load increment ``ps.increment``."""
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op)
     dut = problem.linear_solver(s.backend).solve(Kr, problem.op.reduce(problem.F_scaled))
-    return abs(ps.increment) * float(np.linalg.norm(dut))
+    return abs(ps.increment) * float(np.linalg.norm(dut * arc_weights(problem)))
