@@ -6,11 +6,12 @@
   procedure that handles snap-through", Comput. Struct. 13): the load factor is an unknown and
   the increment satisfies ‖w ∘ Δu_r‖² + ψ² Δλ² ‖q‖² = Δl² (ψ = 0: cylindrical, ψ = 1:
   spherical), q = Tᵀ F_scaled, with w the length of each DOF (:func:`arc_weights`: t^l for a
-  director coefficient u_l, so that Δl is a displacement). Each iteration solves K_r [a, b] = [r, q] with one factorisation (bordering
-  by superposition, δu = a + δλ b); δλ is the root of the quadratic constraint closest to the
-  previous increment (Crisfield). Predictor sign: the previous increment's direction
-  (sign Δuₚᵣₑᵥ · δu_t > 0; Feng, Perić & Owen 1996); on the first increment and after an
-  increment that changed the state (debonding) the work criterion sign(Δλ) = sign(qᵀδu_t)
+  director coefficient u_l, so that Δl is a displacement). Each iteration solves
+  K_r [a, b] = [r, q] with one factorisation (bordering by superposition, δu = a + δλ b); δλ is
+  the root of the quadratic constraint closest to the previous increment (Crisfield). Predictor
+  sign: the previous increment's direction (sign Δuₚᵣₑᵥ · δu_t > 0; Feng, Perić & Owen 1996); on
+  the first increment and after an increment that changed the state (debonding) the work
+  criterion sign(Δλ) = sign(qᵀδu_t)
   (load further where the current state is stable under load control, unload where it is not).
 * Dissipation-based control (Gutiérrez 2004, Int. J. Numer. Meth. Engng 59; Verhoosel,
   Remmers & Gutiérrez 2009, Int. J. Numer. Meth. Engng 77): for damage with secant unloading the
@@ -53,7 +54,7 @@ class PathSettings:
     lambda_end: float = 1.0
     increment: float = 0.1  # first Δλ (load control); arc length: sets the first arc length
     increment_max: float | None = None  # default 10 × increment (load control)
-    arc_length: float | None = None  # first Δl; default: ‖w ∘ Δu_r‖ (arc_weights) of the linear predictor for ``increment``
+    arc_length: float | None = None  # first Δl; default: ‖w ∘ Δu_r‖ of the linear predictor for ``increment``
     arc_length_min: float | None = None  # default arc_length / 1000
     arc_length_max: float | None = None  # default 10 × arc_length
     psi: float = 0.0
@@ -267,9 +268,8 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             att.message = "converged at the round-off floor"
             return dur, dlam, True
         if mode == "arc":
-            # ‖dur + a + δλ b‖² + ψ²(Δλ + δλ)² qq = Δl²  (Crisfield 1981)
-            w = dur + a
-            # the increments in length units: each director's coefficient times t^l (arc_weights)
+            # ‖w ∘ (dur + a + δλ b)‖² + ψ²(Δλ + δλ)² qq = Δl²  (Crisfield 1981), the increments in
+            # length units: each director's coefficient times t^l (arc_weights)
             w, bw, dw = (dur + a) * wr, b * wr, dur * wr
             A = float(bw @ bw) + ps.psi**2 * qq
             B = 2.0 * float(w @ bw) + 2.0 * ps.psi**2 * qq * dlam
@@ -558,7 +558,7 @@ def full_weights(problem: Problem) -> np.ndarray:
 def arc_weights(problem: Problem) -> np.ndarray:
     """:func:`full_weights` of the reduced (independent) DOFs: the arc length and the sizes of
     the path increments are measured in length units, ‖w ∘ Δu_r‖. The director coefficients
-    u_l carry 1/length^l: in the plain DOF norm the cubic director of the 10 mm TRC layer of the
+    u_l carry length^(1-l): in the plain DOF norm the cubic director of the 10 mm TRC layer of the
     §5.1 plate (MITC9, 12 × 12) made up 99.97 % of an increment, so the constraint controlled
     that layer's thickness change instead of the plate's deflection, and the second increment
     converged at λ = -0.39 from +0.04 with the same Δu. Cached per constraint operator."""
