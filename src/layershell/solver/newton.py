@@ -81,7 +81,7 @@ class ConvergenceError(RuntimeError):
         self.residual = residual
 
 
-#: re-freezings of the cohesive sets where a failed frozen solve left them, per call of :func:`newton`
+#: re-freezings of the cohesive sets at the best iterate of a failed frozen solve, per call of :func:`newton`
 MAX_REFREEZE = 3
 
 
@@ -104,12 +104,12 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     and a set that has not settled after ``max_active_set_loops``, or cycles, is a failure (the
     step is cut) - unless a converged state of the loop violates the damage law by less than the
     consistency tolerance (:class:`ActiveSetLoop`), which is then accepted and counted.
-    A frozen solve that does not converge freezes the sets again where they no longer hold -
-    at its best iterate, else at its last one - and goes on (at most ``MAX_REFREEZE`` times per
-    call): the frozen problem need not have a solution at the load (its path can turn back
-    before it, while the actual one goes on with other sets). The cohesive §5.1 plate with MITC9
-    (12 × 12) stalled at λ = 0.995 with a residual of 4·10⁻⁵ of the load through 8 bisections,
-    with and without friction; now it reaches λ = 1 (tests/test_cohesive_plate.py)."""
+    A frozen solve that does not converge, but whose best iterate no longer satisfies the frozen
+    sets, freezes them again there and goes on (at most ``MAX_REFREEZE`` times per call): the
+    frozen problem need not have a solution at the load (its path can turn back before it,
+    while the actual one goes on with other sets). The cohesive §5.1 plate with MITC9 (12 × 12,
+    μ0 = 0) stalled at λ = 0.995 with a residual of 4·10⁻⁵ of the load through 8 bisections; now
+    it reaches λ = 1 (tests/test_cohesive_plate.py)."""
     u = problem.impose(u, lam)  # prescribed displacements at this load factor (displacement control)
     blocks, cohesive_only = active_set_blocks(problem)
     if not blocks:
@@ -170,12 +170,10 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         if (not res.converged and cohesive_only and refreeze > 0 and res.best is not None
                 and total.iterations < s.max_contact_iterations):
             # the frozen problem has no solution near this load (its path turns back before it):
-            # freeze the sets again where they no longer hold - at the best iterate, else at the
-            # last one (with friction on the damaged share the best iterate kept the sets)
-            at = res.best if any(b.set_changed(res.best) for b in blocks) else u_new
-            if any(b.set_changed(at) for b in blocks):
+            # freeze the sets again at the best iterate, where they no longer hold
+            if any(b.set_changed(res.best) for b in blocks):
                 refreeze -= 1
-                u = at
+                u = res.best
                 continue
         if not res.converged:
             if total.iterations >= s.max_contact_iterations:
