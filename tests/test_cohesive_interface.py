@@ -333,3 +333,84 @@ def test_arc_length_iterations_end_at_the_round_off_floor():
     # the next increment (same direction) too
     att2 = arc_attempt(pb, att.u, att.lam, size, "arc", att.u - u0, s, ps, 1.0)
     assert att2.converged and "floor" in att2.message and att2.lam > att.lam
+
+
+def test_stabilisation_switches_on_at_the_converged_state():
+    """InterfaceController.stabilize (the automatic viscous stabilisation of a load step without
+    equilibrium, solver/newton.py ``NewtonSettings.stabilize``): at the converged state it leaves
+    the internal force unchanged (the acting damage starts at the rate-independent one), beyond
+    it the damage lags the rate-independent damage, and the checkpoint/step-cut state carries the
+    viscosity and where it was switched on."""
+    spec = strip(nonlinear="false", nx=2, load="0.5", steps=1, cohesive={"smax": 0.3, "tmax": 0.6})
+    pb = Problem.build(spec.model)
+    ctl, blk = pb.interfaces, pb.extra_blocks[0]
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=pb.dm.n_full) * 1e-4
+    ctl.update(pb, u, 0.5)
+    assert blk.d_old.max() > 0 and ctl.stabilized is None
+    pb.external(0.5)
+    f0, _ = pb.assembler.evaluate(u, tangent=False)
+    assert ctl.stabilize(0.01, 0.5) and blk.law.viscosity == 0.01 == ctl.runs[0].law.viscosity
+    f1, _ = pb.assembler.evaluate(u, tangent=False)
+    np.testing.assert_allclose(f1, f0, rtol=0, atol=1e-12 * np.abs(f0).max())
+    assert not ctl.stabilize(0.02, 0.5)  # once
+    u2 = 1.5 * u
+    pb.external(0.51)  # Δλ = η: the damage goes half way to the rate-independent one
+    _, _, d, _ = blk.point_state(u2)
+    grow = blk.last_inviscid > blk.d_old + 1e-6
+    assert grow.any()
+    np.testing.assert_allclose(d[grow], 0.5 * (blk.dv_old + blk.last_inviscid)[grow], rtol=1e-12)
+    state = ctl.state(pb)
+    pb2 = Problem.build(spec.model)
+    pb2.interfaces.restore(pb2, state)
+    assert pb2.extra_blocks[0].law.viscosity == 0.01 and pb2.interfaces.stabilized == {"load_factor": 0.5, "viscosity": 0.01}
+
+
+def test_load_steps_stabilise_a_step_without_equilibrium(monkeypatch):
+    """load_steps: a step that fails through all its bisections is solved again with the viscous
+    stabilisation switched on at the last converged load factor, η = stabilize × the step's
+    increment; with stabilize = 0 the run stops there as before (ConvergenceError). (Newton is
+    replaced by a stand-in that has no equilibrium beyond λ = 0.5 until the interfaces are
+    stabilised; the physics: tests/test_cohesive_plate.py, the MITC9 plate on 12 × 12.)"""
+    from types import SimpleNamespace
+
+    from layershell.solver import newton as nw
+
+    class Interfaces:
+        stabilized = None
+        viscous_per_step = 0.01  # against 1.0 of fracture energy per step
+
+        def stabilize(self, eta, lam):
+            self.stabilized = {"load_factor": lam, "viscosity": eta}
+            return True
+
+        def cohesive(self):
+            return True
+
+        def dissipation(self):  # (fracture, viscous) so far: one unit per call, viscous once stabilised
+            self.calls = getattr(self, "calls", 0) + 1
+            self.visc = getattr(self, "visc", 0.0) + (self.viscous_per_step if self.stabilized else 0.0)
+            return float(self.calls), self.visc
+
+    def stand_in(problem, u, lam, s):
+        ok = lam <= 0.5 + 1e-12 or problem.interfaces.stabilized is not None
+        return u + 1.0, nw.NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
+
+    monkeypatch.setattr(nw, "newton", stand_in)
+    targets = np.array([0.25, 0.5, 0.75, 1.0])
+    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
+    steps = list(nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.02)))
+    assert [st.load_factor for st in steps] == [0.25, 0.5, 0.75, 1.0]
+    assert pb.interfaces.stabilized == {"load_factor": 0.5, "viscosity": pytest.approx(0.02 * 0.25)}
+    assert steps[2].bisections == 2  # the failed halvings; then the step again, in one piece
+    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
+    with pytest.raises(nw.ConvergenceError, match="last converged load factor is 0.5.*stabilize = 0.02"):
+        list(nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.0)))
+    # a stabilised step whose viscous dissipation exceeds stabilize_limit of the step's: a limit point
+    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
+    pb.interfaces.viscous_per_step = 0.2
+    done = []
+    with pytest.raises(nw.ConvergenceError, match="limit point near load factor 0.5"):
+        for st in nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.02)):
+            done.append(st.load_factor)
+    assert done == [0.25, 0.5]

@@ -366,6 +366,8 @@ def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
         cause = ("the stiffness matrix is singular, usually because the supports leave a rigid-body motion free: "
                  "supports must prevent every rigid-body motion (3 translations and 3 rotations), so check "
                  "'supports'")
+    elif "limit point near load factor" in msg:  # a stabilised run past the peak of the load (solver/newton.py)
+        cause = "the load factors beyond the limit point are not equilibrium states of the rate-independent law"
     else:
         cause = ("check that the supports prevent every rigid-body motion (3 translations and 3 rotations); if "
                  "they do, the load may pass a limit point or be too large for one step: use more load steps "

@@ -184,6 +184,28 @@ class _ProbeFloors:
         return out
 
 
+def _stabilized(summary: dict, where: dict, energy: dict | None, step: int, log) -> None:
+    """summary['stabilized'] of a run whose cohesive interfaces the load stepping regularised
+    (NewtonSettings.stabilize): where, η, and the viscous share of the dissipation so far; warns
+    once when it is switched on."""
+    visc = (energy or {}).get("dissipated_viscous", 0.0)
+    total = visc + (energy or {}).get("dissipated_fracture", 0.0)
+    first = "stabilized" not in summary
+    summary["stabilized"] = {**where, "dissipated_viscous": visc,
+                             "viscous_share_of_dissipation": visc / total if total > 0 else 0.0}
+    if first:
+        import warnings as _w
+
+        m = (f"step {step}: no equilibrium of the rate-independent cohesive law near λ = {where['load_factor']:.6g} "
+             f"(all bisections failed); the viscous regularisation was switched on from there with η = "
+             f"{where['viscosity']:.3g} (load-factor units, [steps] stabilize) - the summary's 'stabilized' and "
+             "energy.dissipated_viscous show its share of the dissipation; where it is not small, follow the "
+             "path by control = 'arc_length' or smaller steps")
+        summary.setdefault("warnings", []).append(m)
+        _w.warn(m, CohesiveWarning, stacklevel=2)
+        log(f"warning: {m}")
+
+
 def _path_arrays(st) -> dict[str, np.ndarray]:
     state = getattr(st, "state", None)
     return state.arrays() if state is not None else {}
@@ -452,7 +474,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     problem.monitor = on_iteration  # called by the Newton loop (solver/newton.py)
 
     def checkpoint_summary() -> dict:
-        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end")
+        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end", "stabilized")
                 if k in summary}
 
     if progress is not None and step0:
@@ -501,6 +523,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     summary["energy"] = energy
                     summary["first_damage_load_factor"] = ctl.first_damage()
                     summary["peak_load_factor"] = max(float(st.load_factor), summary["peak_load_factor"] or 0.0)
+                if ctl is not None and ctl.stabilized is not None:  # automatic viscous stabilisation (solver/newton.py)
+                    _stabilized(summary, ctl.stabilized, energy, st.step, log)
                 if getattr(problem, "accepted_sets", 0):  # cohesive active sets accepted within their tolerance (solver/newton.py)
                     summary["active_set"] = {"accepted_within_tolerance": problem.accepted_sets,
                                              "largest_violation": problem.accepted_violation}
@@ -535,9 +559,10 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         summary["converged"] = True
     except ConvergenceError as exc:
         done = summary["steps"][-1]["step"] if summary["steps"] else 0
-        failure = {"step": done + 1, "load_factor": float(exc.load_factor), "residual": float(exc.residual)}
+        failure = {"step": done + 1, "load_factor": float(exc.load_factor),
+                   "residual": float(exc.residual) if np.isfinite(exc.residual) else None}
         message = str(exc)
-        if "residual" not in message:
+        if "residual" not in message and np.isfinite(exc.residual):
             message += f" (last residual {exc.residual:.3e})"
         summary["error"] = message
         summary["failure"] = failure

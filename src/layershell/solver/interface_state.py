@@ -21,7 +21,7 @@ In both, σ33 is the contact pressure and there is no friction where the gap is 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
@@ -160,6 +160,7 @@ class InterfaceController:
     lam: float = 0.0
     mesh_nodes: np.ndarray | None = None  # for plots
     new_warnings: list = field(default_factory=list)  # warnings of the last update (cohesive process zone)
+    stabilized: dict | None = None  # automatic viscous stabilisation: {load_factor, viscosity} (stabilize)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
     f_last: np.ndarray | None = None  # [external force, layers' internal force] there
@@ -352,7 +353,10 @@ class InterfaceController:
                 out[f"run{i}.block.d_old"] = np.array(r.block.d_old, copy=True)
                 out[f"run{i}.block.dv_old"] = np.array(r.block.dv_old, copy=True)
                 out[f"run{i}.block.lam_old"] = np.array(r.block.lam_old, float)
+                out[f"run{i}.viscosity"] = np.array(r.law.viscosity, float)
         out["energy"] = np.array(self.energy, copy=True)
+        if self.stabilized is not None:
+            out["stabilized"] = np.array([self.stabilized["load_factor"], self.stabilized["viscosity"]])
         if self.u_last is not None:
             out["energy.u"], out["energy.f"] = self.u_last.copy(), self.f_last.copy()
         return out
@@ -392,7 +396,12 @@ class InterfaceController:
                 r.block.d_old = take(f"run{i}.block.d_old", r.block.d_old)
                 r.block.dv_old = take(f"run{i}.block.dv_old", r.block.dv_old)
                 r.block.lam_old = float(take(f"run{i}.block.lam_old", None))
+                if f"run{i}.viscosity" in state:  # automatic stabilisation (stabilize) switched it on or off
+                    r.law = replace(r.law, viscosity=float(state[f"run{i}.viscosity"]))
+                    r.block.law = r.law
             _kin(r.block).active = None
+        self.stabilized = ({"load_factor": float(state["stabilized"][0]), "viscosity": float(state["stabilized"][1])}
+                           if "stabilized" in state else None)
         if "energy" in state:
             self.energy = np.array(state["energy"], float)
             self.u_last = np.array(state["energy.u"]) if "energy.u" in state else None
@@ -400,6 +409,33 @@ class InterfaceController:
         self.resolves = 0
         problem.rebuild_constraints()
         self.sync(problem)
+
+    # ------------------------------------------------------------------ stabilisation
+    def stabilize(self, eta: float, lam: float) -> bool:
+        """Switch on the viscous regularisation (Gao & Bower 2004, :class:`CohesiveBlock`) with
+        the time ``eta`` (load-factor units) on every cohesive interface that has none, from the
+        converged state at ``lam`` on; ``load_steps`` does this when a step fails through all its
+        bisections (``NewtonSettings.stabilize``). The acting damage starts equal to the
+        rate-independent one, so the converged state is unchanged; the viscous share of the
+        dissipation is booked in the energy ledger. False: nothing to switch on."""
+        coh = [r for r in self.runs if isinstance(r, CohesiveRun) and r.law.viscosity == 0]
+        if not coh or not eta > 0:
+            return False
+        for r in coh:
+            r.law = replace(r.law, viscosity=float(eta))
+            r.block.law = r.law
+            r.block.dv_old = np.array(r.block.dv_old if r.block.dv_old is not None else r.block.d_old, copy=True)
+        self.stabilized = {"load_factor": float(lam), "viscosity": float(eta)}
+        return True
+
+    def cohesive(self) -> bool:
+        """Whether any interface has the cohesive law."""
+        return any(isinstance(r, CohesiveRun) for r in self.runs)
+
+    def dissipation(self) -> tuple[float, float]:
+        """(fracture, viscous): the energy the cohesive interfaces have dissipated so far."""
+        coh = [r for r in self.runs if isinstance(r, CohesiveRun)]
+        return sum(float(r.energy[0]) for r in coh), sum(float(r.energy[2]) for r in coh)
 
     # ------------------------------------------------------------------ results
     def first_failure(self) -> float | None:

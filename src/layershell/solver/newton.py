@@ -50,6 +50,17 @@ class NewtonSettings:
     # point whose normal separation crosses zero in a full step meets the mirror image of its
     # softening branch, and Newton ping-pongs between the two sides)
     stagnation_iterations: int = 3
+    # load steps with cohesive interfaces: when a step fails through all its bisections, switch on
+    # the viscous regularisation with the time η = stabilize × the step's load-factor increment and
+    # solve the step again (InterfaceController.stabilize; 0: off, the run stops there). Where the
+    # path of the frozen problem turns back (a local snap-back: the MITC9 plate at λ = 0.995 on
+    # 12 × 12), no load step of the rate-independent law has an equilibrium nearby
+    stabilize: float = 0.0
+    # ... and the run stops at a stabilised step whose viscous dissipation exceeds this share of
+    # the step's dissipation (fracture + viscous): the load is then carried by the regularisation,
+    # past a limit point of the load (the force-loaded DCB past its peak: 1.3 % in the first step
+    # beyond, 7.6 % in the second, 31 % at P = 70 N, 12 % above the peak, without this check)
+    stabilize_limit: float = 0.05
 
 
 @dataclass
@@ -462,7 +473,8 @@ def load_steps(
     lam = lam0
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
-        total_it, bis, cuts = 0, 0, 0
+        total_it, bis, cuts, halved = 0, 0, 0, 0
+        e0 = problem.interfaces.dissipation() if hasattr(problem.interfaces, "dissipation") else None
         residuals: list[float] = []
         inc = target - lam
         while True:
@@ -501,10 +513,18 @@ def load_steps(
             if snap is not None:
                 problem.restore(snap)  # the failed Newton solve may have changed contact states
             bis += 1
+            if bis > s.max_bisections and s.stabilize > 0 and getattr(problem.interfaces, "stabilized", 1) is None:
+                eta = s.stabilize * abs(target - (load_factors[n - step0 - 2] if n - step0 >= 2 else lam0))
+                if problem.interfaces.stabilize(eta, lam):
+                    halved, bis, inc = s.max_bisections, 0, target - lam  # the step again, viscous from the converged state on
+                    continue
             if bis > s.max_bisections:
+                hint = ("; a model with cohesive interfaces passes such a step (a local snap-back) with [steps] "
+                        "stabilize = 0.02 (viscous regularisation from there on, its share reported)"
+                        if s.stabilize == 0 and getattr(problem.interfaces, "cohesive", lambda: False)() else "")
                 raise ConvergenceError(
                     f"step {n}: no convergence towards load factor {trial:.6g} after {s.max_bisections} "
-                    f"bisections ({res.message}); the last converged load factor is {lam:.6g}",
+                    f"bisections ({res.message}); the last converged load factor is {lam:.6g}{hint}",
                     trial, res.residuals[-1] if res.residuals else float("nan"))
             inc *= 0.5
         if on_step_end is not None and cut is None:
@@ -516,4 +536,24 @@ def load_steps(
                     raise ConvergenceError(
                         f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}",
                         lam, res.residuals[-1] if res.residuals else float("nan"))
-        yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts, time.perf_counter() - t0)
+        if getattr(problem.interfaces, "stabilized", None) is not None:
+            _check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
+        yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0)
+
+
+def _check_stabilised_step(problem: Problem, n: int, lam: float, e0: tuple[float, float] | None,
+                           limit: float) -> None:
+    """ConvergenceError where the viscous share of a stabilised step's dissipation exceeds
+    ``limit`` (NewtonSettings.stabilize_limit): past a limit point of the load."""
+    if e0 is None or not limit > 0:
+        return
+    f1, v1 = problem.interfaces.dissipation()
+    df, dv = f1 - e0[0], v1 - e0[1]
+    if dv > limit * (df + dv):
+        lam_s = problem.interfaces.stabilized["load_factor"]
+        raise ConvergenceError(
+            f"step {n}: the viscous stabilisation switched on at load factor {lam_s:.6g} dissipated "
+            f"{dv / (df + dv):.1%} of the dissipation of the step to {lam:.6g} (limit {limit:.0%}, [steps] "
+            f"stabilize_limit): the load is carried by the regularisation, not the interface - the load "
+            f"passed a limit point near load factor {lam_s:.6g} (the capacity under this load); follow "
+            f"the path past it with control = 'arc_length'", lam, float("nan"))
