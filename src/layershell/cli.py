@@ -366,7 +366,7 @@ def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
         cause = ("the stiffness matrix is singular, usually because the supports leave a rigid-body motion free: "
                  "supports must prevent every rigid-body motion (3 translations and 3 rotations), so check "
                  "'supports'")
-    elif "limit point near load factor" in msg:  # a stabilised run past the peak of the load (solver/newton.py)
+    elif "the regularisation, not the interface, carries the load" in msg:  # stabilised (solver/newton.py)
         cause = "the load factors beyond the limit point are not equilibrium states of the rate-independent law"
     else:
         cause = ("check that the supports prevent every rigid-body motion (3 translations and 3 rotations); if "

@@ -384,15 +384,15 @@ class Steps(Strict):
         100, le=100_000, description="models with contact: Newton iterations per equilibrium solve in all "
         "(semi-smooth and active-set loops) before the load increment is bisected")
     stabilize: float = Field(
-        0.0, ge=0, le=10, description="fixed load steps with cohesive interfaces: when a step fails through all "
-        "its bisections, the viscous regularisation (interfaces' 'viscosity') is switched on from there with the "
+        0.0, ge=0, le=10, description="control = 'load' (fixed or adaptive steps) with cohesive interfaces: when "
+        "a step fails through all its bisections (cuts), the viscous regularisation (interfaces' 'viscosity') is switched on from there with the "
         "time η = stabilize × the step's load-factor increment (0.02 is a good value) and the step is solved "
         "again; the run warns, summary.json names the load factor and the viscous share ('stabilized') and the "
         "energy ledger the viscous dissipation. 0 (default): off, the run stops at such a step")
     stabilize_limit: float = Field(
         0.05, gt=0, le=1, description="stabilised runs stop at a step whose viscous dissipation exceeds this "
-        "share of the step's dissipation: the load has passed a limit point (the capacity under this load) and "
-        "is carried by the regularisation; follow the path past it with control = 'arc_length'")
+        "share of the step's dissipation: the regularisation, not the interface, then carries the load, past a "
+        "limit point of the load or a snap-back; follow the path with control = 'arc_length' or refine the mesh")
     solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
         "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
     control: Literal["load", "arc_length"] = Field(

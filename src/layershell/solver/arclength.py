@@ -38,7 +38,7 @@ import numpy as np
 
 from . import linear
 from .newton import (ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
-                     newton, stagnates)
+                     check_stabilised_step, newton, stagnates)
 from .problem import Problem
 
 
@@ -387,6 +387,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
+        e0 = problem.interfaces.dissipation() if hasattr(problem.interfaces, "dissipation") else None
         residuals: list[float] = []
         allow_jump = tried_dissipation = False
         warns: list[str] = []
@@ -475,6 +476,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
+                if (st.mode == "load" and s.stabilize > 0 and getattr(problem.interfaces, "stabilized", 1) is None
+                        and problem.interfaces.stabilize(s.stabilize * ps.increment, lam)):
+                    cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
+                    continue
                 raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
                                        f"cuts ({msg}); the last converged load factor is {lam:.6g}",
                                        lam, residuals[-1] if residuals else float("nan"))
@@ -520,6 +525,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
         elif n == ps.max_steps:
             st.finished, end_reason = True, "max_steps"
+        if getattr(problem.interfaces, "stabilized", None) is not None:
+            check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
         res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
                               st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed)
