@@ -197,7 +197,7 @@ def _stabilized(summary: dict, where: dict, energy: dict | None, step: int, log)
         import warnings as _w
 
         m = (f"step {step}: no equilibrium of the rate-independent cohesive law near λ = {where['load_factor']:.6g} "
-             f"(all bisections failed); the viscous regularisation was switched on from there with η = "
+             f"(every cut of the step failed); the viscous regularisation was switched on from there with η = "
              f"{where['viscosity']:.3g} (load-factor units, [steps] stabilize) - the summary's 'stabilized' and "
              "energy.dissipated_viscous show its share of the dissipation; where it is not small, follow the "
              "path by control = 'arc_length' or smaller steps")
