@@ -35,7 +35,8 @@ def study(name: str, n: int, beyond: bool = False) -> dict:
             "first_delamination": s.get("first_delamination_load_factor"),
             "w_front_max": s["probes"].get("w_front_max"), "wall_s": round(time.perf_counter() - t0, 1),
             "cpu_s": round(time.process_time() - c0, 1),
-            "iterations": sum(st["iterations"] for st in s["steps"]), "error": s.get("error")}
+            "iterations": sum(st["iterations"] for st in s["steps"]), "error": s.get("error"),
+            "stabilized": s.get("stabilized"), "balance": (s.get("energy") or {}).get("balance_error")}
 
 
 def main(argv: list[str]) -> None:
