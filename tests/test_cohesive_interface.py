@@ -366,49 +366,64 @@ def test_stabilisation_switches_on_at_the_converged_state():
     assert pb2.extra_blocks[0].law.viscosity == 0.01 and pb2.interfaces.stabilized == {"load_factor": 0.5, "viscosity": 0.01}
 
 
+class _StandInInterfaces:
+    """The part of InterfaceController that the stabilisation in load_steps/path_steps uses:
+    one unit of fracture energy per call of ``dissipation``, and ``viscous_per_step`` of viscous
+    energy once stabilised."""
+
+    stabilized = None
+
+    def __init__(self, viscous_per_step: float):
+        self.viscous_per_step, self.calls, self.visc = viscous_per_step, 0, 0.0
+
+    def stabilize(self, eta, lam):
+        self.stabilized = {"load_factor": lam, "viscosity": eta}
+        return True
+
+    def cohesive(self):
+        return True
+
+    def dissipation(self):  # (fracture, viscous) so far
+        self.calls += 1
+        self.visc += self.viscous_per_step if self.stabilized else 0.0
+        return float(self.calls), self.visc
+
+
+def _stand_in_problem(viscous_per_step: float = 0.01):
+    from types import SimpleNamespace
+
+    return SimpleNamespace(interfaces=_StandInInterfaces(viscous_per_step), dm=SimpleNamespace(n_full=2),
+                           F_scaled=np.zeros(2))
+
+
+def _newton_without_equilibrium_past_half(problem, u, lam, s):
+    """Newton stand-in: no equilibrium beyond λ = 0.5 until the interfaces are stabilised."""
+    from layershell.solver.newton import NewtonResult
+
+    ok = lam <= 0.5 + 1e-12 or problem.interfaces.stabilized is not None
+    return u + 1.0, NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
+
+
 def test_load_steps_stabilise_a_step_without_equilibrium(monkeypatch):
     """load_steps: a step that fails through all its bisections is solved again with the viscous
     stabilisation switched on at the last converged load factor, η = stabilize × the step's
     increment; with stabilize = 0 the run stops there as before (ConvergenceError). (Newton is
     replaced by a stand-in that has no equilibrium beyond λ = 0.5 until the interfaces are
     stabilised; the physics: tests/test_cohesive_plate.py, the MITC9 plate on 12 × 12.)"""
-    from types import SimpleNamespace
-
     from layershell.solver import newton as nw
 
-    class Interfaces:
-        stabilized = None
-        viscous_per_step = 0.01  # against 1.0 of fracture energy per step
-
-        def stabilize(self, eta, lam):
-            self.stabilized = {"load_factor": lam, "viscosity": eta}
-            return True
-
-        def cohesive(self):
-            return True
-
-        def dissipation(self):  # (fracture, viscous) so far: one unit per call, viscous once stabilised
-            self.calls = getattr(self, "calls", 0) + 1
-            self.visc = getattr(self, "visc", 0.0) + (self.viscous_per_step if self.stabilized else 0.0)
-            return float(self.calls), self.visc
-
-    def stand_in(problem, u, lam, s):
-        ok = lam <= 0.5 + 1e-12 or problem.interfaces.stabilized is not None
-        return u + 1.0, nw.NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
-
-    monkeypatch.setattr(nw, "newton", stand_in)
+    monkeypatch.setattr(nw, "newton", _newton_without_equilibrium_past_half)
     targets = np.array([0.25, 0.5, 0.75, 1.0])
-    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
+    pb = _stand_in_problem()
     steps = list(nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.02)))
     assert [st.load_factor for st in steps] == [0.25, 0.5, 0.75, 1.0]
     assert pb.interfaces.stabilized == {"load_factor": 0.5, "viscosity": pytest.approx(0.02 * 0.25)}
     assert steps[2].bisections == 2  # the failed halvings; then the step again, in one piece
-    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
+    pb = _stand_in_problem()
     with pytest.raises(nw.ConvergenceError, match="last converged load factor is 0.5.*stabilize = 0.02"):
         list(nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.0)))
     # a stabilised step whose viscous dissipation exceeds stabilize_limit of the step's: a limit point
-    pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2))
-    pb.interfaces.viscous_per_step = 0.2
+    pb = _stand_in_problem(viscous_per_step=0.2)
     done = []
     with pytest.raises(nw.ConvergenceError, match="past load factor 0.5 the rate-independent path has no equilibrium"):
         for st in nw.load_steps(pb, targets, nw.NewtonSettings(max_bisections=2, stabilize=0.02)):
@@ -425,37 +440,14 @@ def test_adaptive_load_steps_stabilise_a_step_without_equilibrium(monkeypatch):
     went on to δ = 10 mm with 28 % of its dissipation viscous and its branch 27 % above beam
     theory without that check; with it, it stops at 5.55 mm instead of 5.45). Newton is a
     stand-in without equilibrium beyond λ = 0.5 until the interfaces are stabilised."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver import newton as nw
 
-    class Interfaces:
-        stabilized = None
-        viscous = 0.01  # per increment, against 1.0 of fracture energy
-
-        def stabilize(self, eta, lam):
-            self.stabilized = {"load_factor": lam, "viscosity": eta}
-            return True
-
-        def cohesive(self):
-            return True
-
-        def dissipation(self):
-            self.calls = getattr(self, "calls", 0) + 1
-            self.visc = getattr(self, "visc", 0.0) + (self.viscous if self.stabilized else 0.0)
-            return float(self.calls), self.visc
-
-    def stand_in(problem, u, lam, s):
-        ok = lam <= 0.5 + 1e-12 or problem.interfaces.stabilized is not None
-        return u + 1.0, nw.NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
-
-    monkeypatch.setattr(al, "newton", stand_in)
+    monkeypatch.setattr(al, "newton", _newton_without_equilibrium_past_half)
     ps = al.PathSettings(control="load", lambda_end=1.0, increment=0.25, max_cuts=2, jump_area=None, jump_ratio=None)
 
     def path(stabilize, viscous=0.01):
-        pb = SimpleNamespace(interfaces=Interfaces(), dm=SimpleNamespace(n_full=2), F_scaled=np.zeros(2))
-        pb.interfaces.viscous = viscous
+        pb = _stand_in_problem(viscous_per_step=viscous)
         lams = []
         try:
             for st in al.path_steps(pb, nw.NewtonSettings(stabilize=stabilize), ps):

@@ -38,7 +38,7 @@ import numpy as np
 
 from . import linear
 from .newton import (ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
-                     check_stabilised_step, newton, stagnates)
+                     check_stabilised_step, dissipation_so_far, newton, stabilise, stagnates)
 from .problem import Problem
 
 
@@ -387,7 +387,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
-        e0 = problem.interfaces.dissipation() if hasattr(problem.interfaces, "dissipation") else None
+        e0 = dissipation_so_far(problem)
         residuals: list[float] = []
         allow_jump = tried_dissipation = False
         warns: list[str] = []
@@ -476,8 +476,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
-                if (st.mode == "load" and s.stabilize > 0 and getattr(problem.interfaces, "stabilized", 1) is None
-                        and problem.interfaces.stabilize(s.stabilize * ps.increment, lam)):
+                if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
                     cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
                     continue
                 raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
@@ -525,8 +524,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
         elif n == ps.max_steps:
             st.finished, end_reason = True, "max_steps"
-        if getattr(problem.interfaces, "stabilized", None) is not None:
-            check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
+        check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
         res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
                               st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed)
@@ -551,7 +549,11 @@ def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissip
 def full_weights(problem: Problem) -> np.ndarray:
     """Per full-space DOF the length by which its coefficient moves its layer's far face: t^l
     for director l of a layer of (nodal) thickness t (u = Σ (Θ³)^l u_l, 0 ≤ Θ³ ≤ t; MODEL.md
-    (2.17)), 1 for the displacements u_0 and for DOFs of no layer."""
+    (2.17)), 1 for the displacements u_0 and for DOFs of no layer. Built once per problem (the
+    DOF map does not change; the turn-back check and every arc attempt use it)."""
+    w = getattr(problem, "_full_weights", None)
+    if w is not None:
+        return w
     w = np.ones(problem.dm.n_full)
     for ld, ly in zip(problem.dm.layer_dofs, problem.model.layers):
         t = np.broadcast_to(np.asarray(ly.thickness, float), (ld.shape[0],))
@@ -559,6 +561,7 @@ def full_weights(problem: Problem) -> np.ndarray:
             idx = ld[:, l, :]
             ok = idx >= 0
             w[idx[ok]] = np.broadcast_to((t**l)[:, None], idx.shape)[ok]
+    problem._full_weights = w
     return w
 
 

@@ -472,11 +472,11 @@ def load_steps(
     """
     s = settings or NewtonSettings()
     u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
-    lam = lam0
+    lam = prev_target = lam0
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
         total_it, bis, cuts, halved = 0, 0, 0, 0
-        e0 = problem.interfaces.dissipation() if hasattr(problem.interfaces, "dissipation") else None
+        e0 = dissipation_so_far(problem)
         residuals: list[float] = []
         inc = target - lam
         while True:
@@ -515,11 +515,9 @@ def load_steps(
             if snap is not None:
                 problem.restore(snap)  # the failed Newton solve may have changed contact states
             bis += 1
-            if bis > s.max_bisections and s.stabilize > 0 and getattr(problem.interfaces, "stabilized", 1) is None:
-                eta = s.stabilize * abs(target - (load_factors[n - step0 - 2] if n - step0 >= 2 else lam0))
-                if problem.interfaces.stabilize(eta, lam):
-                    halved, bis, inc = s.max_bisections, 0, target - lam  # the step again, viscous from the converged state on
-                    continue
+            if bis > s.max_bisections and stabilise(problem, s, abs(target - prev_target), lam):
+                halved, bis, inc = s.max_bisections, 0, target - lam  # the step again, viscous from the converged state on
+                continue
             if bis > s.max_bisections:
                 hint = ("; a model with cohesive interfaces passes such a step (a local snap-back) with [steps] "
                         "stabilize = 0.02 (viscous regularisation from there on, its share reported)"
@@ -538,16 +536,32 @@ def load_steps(
                     raise ConvergenceError(
                         f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}",
                         lam, res.residuals[-1] if res.residuals else float("nan"))
-        if getattr(problem.interfaces, "stabilized", None) is not None:
-            check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
+        check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
+        prev_target = target
         yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0)
+
+
+def dissipation_so_far(problem: Problem) -> tuple[float, float] | None:
+    """(fracture, viscous) energy dissipated by the cohesive interfaces (None: no interface
+    laws), at the start of a step for :func:`check_stabilised_step`."""
+    return problem.interfaces.dissipation() if hasattr(problem.interfaces, "dissipation") else None
+
+
+def stabilise(problem: Problem, s: NewtonSettings, increment: float, lam: float) -> bool:
+    """A step that failed through all its cuts: switch on the viscous stabilisation of the
+    cohesive interfaces from the converged state at ``lam`` with η = ``s.stabilize`` ×
+    ``increment`` (the step's nominal load-factor increment). False where it is off, already on,
+    or there is no cohesive interface: the run stops."""
+    return (s.stabilize > 0 and hasattr(problem.interfaces, "stabilize") and problem.interfaces.stabilized is None
+            and problem.interfaces.stabilize(s.stabilize * increment, lam))
 
 
 def check_stabilised_step(problem: Problem, n: int, lam: float, e0: tuple[float, float] | None,
                            limit: float) -> None:
     """ConvergenceError where the viscous share of a stabilised step's dissipation exceeds
-    ``limit`` (NewtonSettings.stabilize_limit): past a limit point of the load or a snap-back."""
-    if e0 is None or not limit > 0:
+    ``limit`` (NewtonSettings.stabilize_limit): past a limit point of the load or a snap-back.
+    Nothing before the stabilisation is switched on."""
+    if e0 is None or not limit > 0 or getattr(problem.interfaces, "stabilized", None) is None:
         return
     f1, v1 = problem.interfaces.dissipation()
     df, dv = f1 - e0[0], v1 - e0[1]
