@@ -171,3 +171,120 @@ def test_symmetry_is_checked_unless_every_block_declares_it(rng, monkeypatch):
     monkeypatch.setattr(ContactBlock, "symmetric", False)
     _, K2 = pb.assembler.evaluate_reduced(u, pb.op)
     assert not K2.known_symmetric and linear.is_symmetric(K2)
+
+
+def _dcb_problem(nx: int = 6, nonlinear: bool = False, rule: str | None = None):
+    """examples/dcb_cohesive.toml on ``nx`` elements (cohesive interface, nodal rule by default)."""
+    from helpers import EXAMPLES
+
+    from layershell.io.build import build, parse
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text().replace("nx = 150", f"nx = {nx}")
+    if nonlinear:
+        text = text.replace("nonlinear = false", "nonlinear = true")
+    if rule is not None:
+        text = text.replace('law = "cohesive"', f'law = "cohesive"\nrule = "{rule}"')
+    return Problem.build(build(parse(text, str(EXAMPLES / "dcb_cohesive.toml")), EXAMPLES).model)
+
+
+def _opening(pb, rng, scale: float, shear: float = 0.0):
+    """Random DOFs plus an opening of the upper arm of ``scale`` times the onset separation of
+    the cohesive law (some points elastic, some softening, the initial crack fully damaged) and a
+    sliding of ``shear`` times it."""
+    blk = pb.assembler.extra[0]
+    d0 = blk.law.sigma_max / blk.K
+    u = pb.op.expand(1e-3 * d0 * rng.standard_normal(pb.op.n_red))
+    up = pb.dm.layer_dofs[blk.contact.itf.upper][:, 0, :]  # u_0 of the upper layer (node, 3)
+    x = pb.model.mesh.nodes[:, 0]
+    u[up[:, 2]] += scale * d0 * (1.0 - x / x.max())  # opening largest at the loaded end
+    u[up[:, 0]] += shear * d0 * (1.0 - x / x.max())
+    return u
+
+
+def test_linear_bulk_and_point_form_equal_the_element_assembly(rng, monkeypatch):
+    """Issue 13 speed: a geometrically linear model keeps its layer elements' K from the first
+    evaluation (``Assembler._linear_bulk``: f = K_bulk u + the cohesive block), and the cohesive
+    block on the nodal rule is assembled point by point (``ContactBlock._point_form``: one
+    (3 s)² block per face point instead of the element's m² entries). Independent check: the
+    same model assembled element by element with both off gives the same internal force, full
+    tangent and reduced tangent, on a state with elastic, softening and fully damaged points and
+    a mixed mode."""
+    from layershell.assembly import Assembler
+
+    pb = _dcb_problem()
+    A = pb.assembler
+    blk = A.extra[0]
+    assert blk.assembly_dofs is not None and blk.assembly_dofs.shape == (blk.dofs.shape[0] * 9, 3 * 5)
+    ref = _dcb_problem()
+    monkeypatch.setattr(Assembler, "_linear_bulk", lambda self: None)
+    ref.assembler.extra[0].contact.assembly_dofs = None
+    ref.assembler._pattern()
+    assert ref.assembler.nnz > A.nnz  # the element form stores every point's coupling to every node
+    for scale, shear in ((0.5, 0.0), (3.0, 0.0), (3.0, 2.0), (-2.0, 1.0)):
+        u = _opening(pb, rng, scale, shear)
+        f, K = ref.assembler.evaluate(u)
+        monkeypatch.undo()
+        f1, K1 = A.evaluate(u)
+        f2, Kr = A.evaluate_reduced(u, pb.op)
+        monkeypatch.setattr(Assembler, "_linear_bulk", lambda self: None)
+        tol = 1e-12 * abs(K).max()
+        assert np.abs(f1 - f).max() <= 1e-12 * np.abs(f).max() and np.array_equal(f1, f2)
+        assert abs(K1 - K).max() <= tol
+        assert abs(Kr - (pb.op.T.T @ K @ pb.op.T)).max() <= tol
+    assert A._bulk is not None and A._bulk.reduced is not None
+
+
+def test_point_form_of_the_contact_block_equals_its_element_form(rng):
+    """The point form (nodal rule) of a ContactBlock with released points in contact and
+    friction: each point's (3 s)² block scattered to its element's DOFs gives the element form's
+    force and tangent (``response(points=True)`` against ``response()``); on the Gauss rule
+    there is no point form (every point sees every node)."""
+    from layershell.contact import ContactBlock
+    from layershell.interfaces import interfaces
+
+    pb = Problem.build(_three_layers())
+    itf = interfaces(pb.model)[-1]
+    assert ContactBlock.build(pb.model, pb.dm, itf, 1e3).assembly_dofs is None
+    cb = ContactBlock.build(pb.model, pb.dm, itf, 1e3, rule="lobatto")
+    ne, nq, nk = cb.c.shape
+    cb.released = rng.random((ne, nq)) < 0.7
+    cb.alpha_T, cb.cap = 5e2, rng.uniform(0.0, 2e-3, (ne, nq))
+    cb.g_p = 1e-6 * rng.standard_normal((ne, nq, 3))
+    u = 1e-5 * rng.standard_normal(pb.dm.n_full)
+    f, K = cb.response(u)
+    fp, (Kp, rows) = cb.response(u, points=True)
+    n = pb.dm.n_full
+    assert np.allclose(np.bincount(cb.assembly_dofs.ravel(), fp.ravel(), n), np.bincount(cb.dofs.ravel(), f.ravel(), n),
+                       rtol=0, atol=1e-12 * np.abs(f).max())
+    dense = np.zeros((n, n))
+    np.add.at(dense, (cb.dofs[:, :, None], cb.dofs[:, None, :]), K)
+    points = np.zeros((n, n))
+    d = cb.assembly_dofs[rows]
+    np.add.at(points, (d[:, :, None], d[:, None, :]), Kp)
+    assert rows.size == cb.released.sum() and np.abs(points - dense).max() <= 1e-12 * np.abs(dense).max()
+
+
+def test_cohesive_tangent_is_known_symmetric_in_pure_mode_i_only(rng):
+    """A cohesive tangent whose point matrices are exactly symmetric (pure opening along the
+    normal: K g ⊗ ∂d/∂δ with g ∥ ∂d/∂δ ∥ n) skips the solver's O(nnz) symmetry check
+    (``CohesiveBlock.symmetric_now``); a mixed mode with growing damage is not symmetric, and
+    the check stays. Independent check: the assembled K against its transpose."""
+    pb = _dcb_problem()
+    A = pb.assembler
+    u = pb.op.expand(np.zeros(pb.op.n_red))
+    blk = A.extra[0]
+    up = pb.dm.layer_dofs[blk.contact.itf.upper][:, 0, :]
+    x = pb.model.mesh.nodes[:, 0]
+    u[up[:, 2]] = 3.0 * blk.law.sigma_max / blk.K * (1.0 - x / x.max())  # opening only
+    _, K = A.evaluate(u)
+    assert A.symmetric and abs(K - K.T).max() <= 1e-14 * abs(K).max()
+    _, Kr = A.evaluate_reduced(u, pb.op)
+    assert Kr.known_symmetric
+    _, K = A.evaluate(_opening(pb, rng, 3.0, 2.0))
+    assert not A.symmetric and abs(K - K.T).max() > 1e-6 * abs(K).max()
+
+
+def test_nonlinear_model_has_no_linear_bulk():
+    """The cache of the layer elements' tangent is for geometrically linear models only."""
+    assert _dcb_problem(nonlinear=True).assembler._linear_bulk() is None
+    assert _dcb_problem().assembler._linear_bulk() is not None

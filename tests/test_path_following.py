@@ -436,6 +436,22 @@ def test_stagnation_detects_stalled_and_cycling_newton_only():
     assert first([2566.0] * 10, 0) is None  # off
 
 
+def test_a_stalled_path_after_the_peak_ends_as_complete_failure():
+    """The arc length ends a path that no longer moves far below its peak (the DCB on 200
+    elements crawled at λ = 0.00906, 1.5 % of its peak 0.61, for 1700 increments): 25 increments
+    within end_fraction × the peak of each other, all below 5 % of it. Not near the peak (a hard
+    crack front there is not the end), not while λ still changes, not before 25 increments."""
+    from layershell.solver.arclength import stalled
+
+    crawl = list(0.00906 + 1e-5 * np.linspace(1, 0, 25))
+    assert stalled(crawl, 25, 0.61, 1e-3)
+    assert not stalled(crawl[1:], 25, 0.61, 1e-3)  # too few
+    assert not stalled(crawl, 25, 0.15, 1e-3)  # 6 % of the peak: not yet
+    assert not stalled(list(0.5 + 1e-5 * np.linspace(1, 0, 25)), 25, 0.61, 1e-3)  # near the peak
+    assert not stalled(list(np.linspace(0.02, 0.01, 25)), 25, 0.61, 1e-3)  # still falling
+    assert not stalled(crawl, 0, 0.61, 1e-3)  # switched off
+
+
 def test_complete_failure_needs_a_dissipating_increment():
     """The path ends by complete failure where λ falls below end_fraction of its peak in an
     increment that dissipates; elastic unloading to λ ≈ 0 (ΔG at round-off, here ±1e-15 of the

@@ -346,6 +346,10 @@ class CohesiveBlock:
     lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
     last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
     symmetric = False
+    #: the last tangent was exactly symmetric at every point (M_q = M_qᵀ: no growing damage in a
+    #: mixed mode, e.g. a pure mode I DCB), so K is symmetric to round-off and the assembler can
+    #: skip the solver's O(nnz) symmetry check (``Assembler.symmetric``); False before a tangent
+    symmetric_now = False
     compact_tangent = False
     smooth_when_frozen = True  # newton(): no residual line search in the active-set loop
 
@@ -453,6 +457,11 @@ class CohesiveBlock:
     def w(self) -> np.ndarray:
         return self.contact.w
 
+    @property
+    def assembly_dofs(self) -> np.ndarray | None:
+        """The point form's DOFs (nodal rule; ``ContactBlock._point_form``) or None."""
+        return self.contact.assembly_dofs
+
     # read by results, probes, plots (as from a ContactBlock)
     itf = property(lambda self: self.contact.itf)
     conn = property(lambda self: self.contact.conn)
@@ -510,9 +519,11 @@ class CohesiveBlock:
             tf, _ = self.contact.friction_traction(u_full, delta)
         return t + d[..., None] * tf, t, tf, d
 
-    def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False):
+    def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False, points: bool = False):
         """Internal force (e, m) and tangent (e, m, m): f_(k,i) = Σ_q c_qk w_q T_qi and
-        K_(k,i)(l,j) = Σ_q c_qk c_ql w_q D_qij (C = c ⊗ I₃, as in ContactBlock.response)."""
+        K_(k,i)(l,j) = Σ_q c_qk c_ql w_q D_qij (C = c ⊗ I₃, as in ContactBlock.response);
+        ``points``: both in the point form of the nodal rule (``assembly_dofs``, (e·q, 3 s) and
+        (e·q, 3 s, 3 s), :meth:`ContactBlock.point_matrices`)."""
         cb = self.contact
         ne, nq, nk = cb.c.shape
         delta, t, d, D, dd = self.point_state(u_full, with_dd=True)
@@ -521,13 +532,20 @@ class CohesiveBlock:
         if friction:
             tf, Df = cb.friction_traction(u_full, delta)
             T = t + d[..., None] * tf
-        f = np.matmul(cb.c.transpose(0, 2, 1), cb.w[..., None] * T).reshape(ne, 3 * nk)
-        if not tangent:
-            return f, None
+        if points:
+            if not tangent:
+                return cb.point_matrices(cb.w[..., None] * T, None)[0], None
+        else:
+            f = np.matmul(cb.c.transpose(0, 2, 1), cb.w[..., None] * T).reshape(ne, 3 * nk)
+            if not tangent:
+                return f, None
         M = D
         if friction:
             M = M + d[..., None, None] * Df + tf[..., :, None] * dd[..., None, :]
         M = cb.w[..., None, None] * M
+        self.symmetric_now = not np.any(M != M.swapaxes(-1, -2))
+        if points:
+            return cb.point_matrices(cb.w[..., None] * T, M)
         c = cb.c
         cM = (c[:, :, None, :, None] * M[:, :, :, None, :]).reshape(ne, nq, 9 * nk)
         K = np.matmul(c.transpose(0, 2, 1), cM).reshape(ne, 3 * nk, 3 * nk)

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from ..assembly import Block, ReducedScatter, build_blocks
+from ..assembly import Block, ReducedScatter, _assembly_dofs, build_blocks
 from ..constraints import ConstraintOperator
 from ..dofs import DofMap
 from ..element.kernel import layer_response
@@ -88,14 +88,17 @@ class LocalAssembly:
         self.blocks = local_blocks(model, dm, self.elements)
         # element-like interface blocks (cohesive, issue 13): ``(block, rows)`` - the block's
         # element rows this rank inserts (its fixed pattern is part of the preallocation)
-        self.extra = [(b, np.asarray(rows, np.int64)) for b, rows in (extra or [])]
-        dofs = [b.dofs.ravel() for b in self.blocks] + [b.dofs[rows].ravel() for b, rows in self.extra]
+        # (rows of the block's assembly form: its face points on the nodal rule, see
+        # ``layershell.assembly._assembly_dofs``)
+        self.extra = [(b, assembly_rows(b, np.asarray(rows, np.int64))) for b, rows in (extra or [])]
+        dofs = ([b.dofs.ravel() for b in self.blocks]
+                + [_assembly_dofs(b)[rows].ravel() for b, rows in self.extra])
         # local full DOFs (compact numbering) and the scatter map into the local full CSR pattern
         # (the construction of Assembler._pattern on this rank's elements only)
         self.full_dofs = np.unique(np.concatenate(dofs)) if dofs else np.zeros(0, np.int64)
         nl = self.full_dofs.size
         self._fidx = ([np.searchsorted(self.full_dofs, b.dofs) for b in self.blocks]
-                      + [np.searchsorted(self.full_dofs, b.dofs[rows]) for b, rows in self.extra])
+                      + [np.searchsorted(self.full_dofs, _assembly_dofs(b)[rows]) for b, rows in self.extra])
         keys = [(d[:, :, None] * nl + d[:, None, :]).ravel() for d in self._fidx]
         key = np.concatenate(keys) if keys else np.zeros(0, np.int64)
         ukey, scatter = np.unique(key, return_inverse=True)
@@ -153,17 +156,30 @@ class LocalAssembly:
         return sp.csr_matrix((data, (self.pattern.rows, self.pattern.cols)), shape=(n, n))
 
 
+def assembly_rows(block, rows: np.ndarray) -> np.ndarray:
+    """The rows of ``block``'s assembly form for its element rows ``rows``: the same rows, or
+    the face points of those elements where the block is assembled point by point."""
+    dofs = _assembly_dofs(block)
+    if dofs is block.dofs:
+        return rows
+    nq = dofs.shape[0] // block.dofs.shape[0]
+    return (rows[:, None] * nq + np.arange(nq)).ravel()
+
+
 def extra_response(block, u_full: np.ndarray, tangent: bool):
-    """``(f (e, m), K (e, m, m) or None)`` of an element-like block, with a compact tangent
-    (``(values, elements)``, only the elements with stiffness) expanded as in
-    ``Assembler._values``."""
-    if getattr(block, "compact_tangent", False):
+    """``(f, K or None)`` of an element-like block in its assembly form (element rows (e, m),
+    (e, m, m), or face points on the nodal rule), with a compact tangent (``(values, rows)``,
+    only the rows with stiffness) expanded as in ``Assembler._values``."""
+    dofs = _assembly_dofs(block)
+    if dofs is not block.dofs:
+        fe, Ke = block.response(u_full, tangent, points=True)
+    elif getattr(block, "compact_tangent", False):
         fe, Ke = block.response(u_full, tangent, compact=True)
     else:
         fe, Ke = block.response(u_full, tangent)
     if tangent and isinstance(Ke, tuple):
         vals, el = Ke
-        full = np.zeros((block.dofs.shape[0], *vals.shape[1:]))
+        full = np.zeros((dofs.shape[0], *vals.shape[1:]))
         full[el] = vals
         Ke = full
     return fe, Ke

@@ -63,6 +63,9 @@ class PathSettings:
     target_iterations: int = 8  # Newton iterations of a 'normal' increment: ×(8/its), within [½, 2]
     max_steps: int = 1000
     end_fraction: float = 1e-3  # arc length: the path ends when λ falls below this fraction of its peak
+    # ... or when, past the peak and below STALL_FRACTION of it, λ has changed by less than
+    # end_fraction × its peak over this many increments (the path stalls: complete failure)
+    stall_increments: int = 25
     max_cuts: int = 12
     max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
     jump_area: float | None = 0.2
@@ -384,6 +387,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     probes_prev = watch(u, lam) if watch is not None else None
     scales = probe_scales({}, probes_prev)
     end = ps.lambda_end
+    recent: list[float] = []  # λ of the last accepted increments (stalled())
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
@@ -519,6 +523,13 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         else:
             st.finished = (to_end or lam >= end
                            or complete_failure(lam, dlam, st.lam_peak, dG, st.dissipated, ps.end_fraction))
+        recent = (recent + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+        if (not st.finished and st.mode != "load"
+                and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
+            st.finished = True
+            warns.append(f"step {n}: the load factor stayed within {max(recent) - min(recent):.3g} of "
+                         f"{lam:.4g} ({100 * abs(lam) / st.lam_peak:.2g} % of its peak {st.lam_peak:.4g}) over the "
+                         f"last {len(recent)} increments: the path ends as complete failure")
         end_reason = None
         if st.finished:
             end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
@@ -534,6 +545,21 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         yield res
         if st.finished:
             return
+
+
+#: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
+STALL_FRACTION = 0.05
+
+
+def stalled(recent: list[float], n: int, lam_peak: float, end_fraction: float) -> bool:
+    """Has the path stalled after its peak? The last ``n`` accepted increments (load factors
+    ``recent``) all lie below STALL_FRACTION of the peak and within ``end_fraction`` × the peak
+    of each other. The DCB on 200 elements, its crack at the clamped end (99.4 % of the
+    interface debonded), crawled at λ = 1.5 % of its peak through 1700 increments: the last
+    bonded row holds an arm that is almost free, each increment's size is cut to nothing, and
+    λ never falls below ``end_fraction`` × the peak."""
+    return (n > 0 and len(recent) >= n and lam_peak > 0 and max(abs(x) for x in recent) <= STALL_FRACTION * lam_peak
+            and max(recent) - min(recent) <= end_fraction * lam_peak)
 
 
 def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissipated: float,
