@@ -288,3 +288,34 @@ def test_nonlinear_model_has_no_linear_bulk():
     """The cache of the layer elements' tangent is for geometrically linear models only."""
     assert _dcb_problem(nonlinear=True).assembler._linear_bulk() is None
     assert _dcb_problem().assembler._linear_bulk() is not None
+
+
+def test_reduced_tangents_of_a_linear_model_never_share_their_values(rng):
+    """The K_r values of a linear model are filled into arrays that no live matrix uses
+    (``_LinearBulk.buffer``): a tangent kept while the next ones are formed keeps its own
+    values, and the array of a tangent that is gone is filled again (no new allocation)."""
+    import gc
+
+    pb = _dcb_problem()
+    A = pb.assembler
+    u1, u2, u3 = (_opening(pb, rng, s, 0.5) for s in (0.5, 3.0, 6.0))
+    _, K1 = A.evaluate_reduced(u1, pb.op)
+    want = K1.data.copy()
+    _, K2 = A.evaluate_reduced(u2, pb.op)
+    _, K3 = A.evaluate_reduced(u3, pb.op)
+    assert np.array_equal(K1.data, want) and not np.shares_memory(K1.data, K2.data)
+    assert not np.shares_memory(K2.data, K3.data) and not np.shares_memory(K1.data, K3.data)
+    reused = K2.data
+    del K2
+    gc.collect()
+    _, K4 = A.evaluate_reduced(u2, pb.op)
+    assert np.shares_memory(K4.data, reused) and np.array_equal(K1.data, want)
+
+
+def test_one_pass_symmetry_check_equals_the_two_passes(rng):
+    """``ReducedTangent.symmetry_check`` (one pass: largest mirror difference and largest
+    entry) gives the values of ``symmetry_error`` and ``max_abs``."""
+    pb = _dcb_problem()
+    _, K = pb.assembler.evaluate_reduced(_opening(pb, rng, 3.0, 2.0), pb.op)
+    err, top = K.symmetry_check()
+    assert err == K.symmetry_error() > 0 and top == K.max_abs() == abs(K).max()

@@ -181,6 +181,25 @@ def max_mirror_difference(data, upper_pos, mirror_pos):  # pragma: no cover - co
 
 
 @njit(cache=True, nogil=True)
+def mirror_difference_and_max(data, upper_pos, mirror_pos):  # pragma: no cover - compiled
+    """(max |K_ab - K_ba|, max |K_ab|) over the upper entries and their mirrors in one pass (every
+    entry is one of them where each upper entry has its mirror)."""
+    m = 0.0
+    a = 0.0
+    for k in range(upper_pos.size):
+        x = data[upper_pos[k]]
+        y = data[mirror_pos[k]]
+        d = abs(x - y)
+        if d > m:
+            m = d
+        if abs(x) > a:
+            a = abs(x)
+        if abs(y) > a:
+            a = abs(y)
+    return m, a
+
+
+@njit(cache=True, nogil=True)
 def gather(data, pos):  # pragma: no cover - compiled
     """data[pos] for an int32 ``pos`` (NumPy would first convert the index array to int64)."""
     out = np.empty(pos.size, data.dtype)
