@@ -285,9 +285,16 @@ def test_cohesive_tangent_is_known_symmetric_in_pure_mode_i_only(rng):
 
 
 def test_nonlinear_model_has_no_linear_bulk():
-    """The cache of the layer elements' tangent is for geometrically linear models only."""
+    """The cache of the layer elements' tangent is for geometrically linear models with
+    interface or contact blocks only (a model without them takes one or two Newton iterations
+    a step: the cache would only cost memory)."""
     assert _dcb_problem(nonlinear=True).assembler._linear_bulk() is None
     assert _dcb_problem().assembler._linear_bulk() is not None
+    m = _three_layers()
+    m.nonlinear = False
+    plain = Problem.build(m)
+    plain.assembler.add_blocks([])
+    assert plain.assembler._linear_bulk() is None
 
 
 def test_reduced_tangents_of_a_linear_model_never_share_their_values(rng):
