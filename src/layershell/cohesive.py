@@ -330,7 +330,8 @@ class CohesiveBlock:
     Kinematics, DOFs and weights are those of :class:`~layershell.contact.ContactBlock` (its
     relative displacement Δu = C U (4.43)-(4.44), its normal A3 and its friction return
     mapping), built on the chosen face rule. The sparsity pattern is fixed (every element's
-    full matrix), so the block is element-like. The tangent is not symmetric where the damage
+    full matrix, or on the nodal rule every face point's block over its node's DOFs:
+    ``assembly_dofs``), so the block is element-like. The tangent is not symmetric where the damage
     grows (K g ⊗ ∂d/∂δ)."""
 
     contact: object  # ContactBlock (kinematics, friction state: cap, g_p, alpha_T)
