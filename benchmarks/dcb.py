@@ -6,6 +6,8 @@ tests/test_dcb.py (``displacement_controlled``).
     PYTHONPATH=src python benchmarks/dcb.py                 # 150, 200, 300 elements
     PYTHONPATH=src python benchmarks/dcb.py 200             # one mesh
     PYTHONPATH=src python benchmarks/dcb.py 300 --viscosity 1e-6   # with viscous regularisation
+    PYTHONPATH=src python benchmarks/dcb.py 100 --relax    # unstable jumps relaxed ([steps] unstable)
+    PYTHONPATH=src python benchmarks/dcb.py 200 --relax --element mitc   # the MITC9 element
     PYTHONPATH=src python benchmarks/dcb.py --arc 100 [600]  # force-loaded, arc length (max steps)
 
 Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
@@ -35,22 +37,28 @@ LENGTH = 150.0
 OPENING = 8.0
 
 
-def displacement_controlled(nx: int, viscosity: float = 0.0):
-    """tests/test_dcb.py ``displacement_controlled`` with an optional viscous regularisation."""
-    if viscosity <= 0:
+def displacement_controlled(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full"):
+    """tests/test_dcb.py ``displacement_controlled`` with an optional viscous regularisation, the
+    relaxation of unstable jumps (``[steps] unstable = "relax"``) and another element."""
+    if viscosity <= 0 and not relax and element == "full":
         return T.displacement_controlled(nx)
     from helpers import run_example
 
-    r = run_example("dcb_cohesive", {**T.DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}",
-                                     "factors = [0.01, 0.02, 0.05,": "n = 100\nadaptive = true\nincrement_max = 0.02 #",
-                                     "tau_max = 30.0": f"tau_max = 30.0\nviscosity = {viscosity!r}"})
+    repl = {**T.DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}",
+            "factors = [0.01, 0.02, 0.05,": ('unstable = "relax"\n' if relax else "")
+            + "n = 100\nadaptive = true\nincrement_max = 0.02 #"}
+    if viscosity > 0:
+        repl["tau_max = 30.0"] = f"tau_max = 30.0\nviscosity = {viscosity!r}"
+    if element != "full":
+        repl['element = "full"'] = f'element = "{element}"'
+    r = run_example("dcb_cohesive", repl)
     steps = r.summary["steps"]
     return (np.array([s["probes"]["P"] for s in steps]), np.array([T.opening(s) for s in steps]), r.summary)
 
 
-def measure(nx: int, viscosity: float = 0.0) -> dict:
+def measure(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full") -> dict:
     t0, c0 = time.perf_counter(), time.process_time()
-    P, d, summary = displacement_controlled(nx, viscosity)
+    P, d, summary = displacement_controlled(nx, viscosity, relax, element)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     pk = int(np.argmax(P))
     ratio = P[pk + 1:] / T.cbt_load_at(P[pk + 1:], d[pk + 1:])
@@ -63,6 +71,8 @@ def measure(nx: int, viscosity: float = 0.0) -> dict:
             "dissipated": e["dissipated_fracture"] / (T.GIC * T.B * (a_end - T.A0)) - 1,
             "balance": e["balance_error"], "converged": summary["converged"],
             "viscous": e.get("dissipated_viscous", 0.0) / max(e["dissipated_fracture"], 1e-300),
+            "relaxed": len([e for e in summary.get("relaxations", [])
+                            if e["debonded_fraction_after"] > e["debonded_fraction_before"]]),
             "accepted": summary.get("active_set", {}).get("accepted_within_tolerance", 0),
             "violation": summary.get("active_set", {}).get("largest_violation", 0.0)}
 
@@ -117,6 +127,13 @@ def main(argv: list[str]) -> None:
               f"{m['P_max']:.2f} | {m['P_end']:.3g} | {m['opening_end']:.2f} | {100 * m['balance']:.2f} % | "
               + ("complete" if m["converged"] else f"stopped: {m['message']}") + " |")
         return
+    relax = "--relax" in argv
+    element = "full"
+    if "--element" in argv:
+        i = argv.index("--element")
+        element = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    argv = [a for a in argv if a != "--relax"]
     viscosity = 0.0
     if "--viscosity" in argv:
         i = argv.index("--viscosity")
@@ -129,14 +146,15 @@ def main(argv: list[str]) -> None:
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for nx in meshes:
-        m = measure(nx, viscosity)
+        m = measure(nx, viscosity, relax, element)
         rows.append(m)
         lo, hi = m["branch"]
         print(f"| {nx} | {m['h']:.3g} | {m['steps']} | {m['iterations']} | {m['cpu']:.0f} | {m['wall']:.0f} | "
               f"{m['P_max']:.2f} | {m['P_8']:.2f} | {100 * lo:+.1f} … {100 * hi:+.1f} % | "
               f"{100 * m['dissipated']:+.1f} % | {100 * m['balance']:.1f} %"
               + ("" if m["converged"] else " (stopped)")
-              + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 else "")
+              + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 or relax else "")
+              + (f", {m['relaxed']} jumps relaxed" if relax else "")
               + f" | {m['accepted']} ({m['violation']:.1e}) |", flush=True)
     if len(rows) == 3:
         h = [m["h"] for m in rows]

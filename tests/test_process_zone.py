@@ -33,8 +33,8 @@ def test_reactions_that_equilibrium_makes_zero_are_no_jump(steps):
     step is arbitrary (measured: 2.8e-14 → -4.5e-13 N, 16× while λ doubled). Without a noise
     floor that is a 'jump' (three warnings on the fixed steps; on adaptive steps a cut and a
     warning). With the floor |scale| ‖ρ‖ tol_residual force_scale (runner._ProbeFloors): none.
-    The check that the floor is needed: the recorded values give jump warnings when the floor
-    is left out."""
+    The check that the floor is needed: the recorded values of the fixed steps give jump
+    warnings when the floor is left out."""
     if steps == "fixed":
         repl = {**ROUND_OFF, "factors = [0.01, 0.02, 0.05,": "factors = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6] #"}
     else:
@@ -55,7 +55,10 @@ def test_reactions_that_equilibrium_makes_zero_are_no_jump(steps):
     lams = [s["load_factor"] for s in st]
     raw = [m for i in range(1, len(st)) for m in jump_warnings(
         i, lams[i], lams[i - 1], None, None, st[i]["probes"], st[i - 1]["probes"], None, 3.0, scales)]
-    assert raw and all("'Rx'" in m or "'Rz'" in m for m in raw)
+    assert all("'Rx'" in m or "'Rz'" in m for m in raw)
+    # the round-off's ratios are machine-dependent: the 6 fixed steps gave raw 'jumps' on every
+    # machine measured, the 3 adaptive ones on an Intel CPU but not on an AMD EPYC
+    assert raw or steps == "adaptive"
 
 
 def test_noise_floor_unit():
@@ -65,6 +68,33 @@ def test_noise_floor_unit():
     assert jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-7}, {"R": 1e-10}, None, 3.0, None, {"R": 1e-8})
     assert jump_warnings(3, 0.75, 0.5, None, None, {"R": 5e-9, "w": 5.0}, {"R": 1e-10, "w": 1.0}, None, 3.0, None,
                          {"R": 1e-8})  # other probes are unaffected
+
+
+def test_reaction_floor_is_at_least_a_millionth_of_the_force_scale():
+    """A reaction probe below 10⁻⁶ of the run's force scale has no meaningful step-to-step
+    ratio even where equilibrium does not make it zero: the DCB opened by prescribed
+    displacements on 100 elements warned that the sum of its arms' reactions 'jumped' from
+    2.7e-6 to -9.0e-6 N against P = 60 N (1.5e-7 of it), below what the residual tolerance
+    resolves in a sum over many nodes. The floor (runner._ProbeFloors) is max(‖ρ‖ tol, 10⁻⁶)
+    × force scale × |scale|; that pair of values is no jump, P itself still is."""
+    from helpers import EXAMPLES
+    from layershell.io.build import build, parse
+    from layershell.runner import _ProbeFloors
+    from layershell.solver.problem import Problem
+    from test_dcb import DISPLACEMENT_CONTROL
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text().replace("nx = 150", "nx = 20")
+    for a, b in DISPLACEMENT_CONTROL.items():
+        text = text.replace(a, b)
+    spec = build(parse(text, "dcb.toml"), EXAMPLES)
+    pb = Problem.build(spec.model)
+    pb.force_scale = 60.0
+    floors = _ProbeFloors(spec, pb)()
+    assert set(floors) == {"P", "P_lower", "P_all"}
+    assert all(v == pytest.approx(60.0 * 1e-6, rel=1e-12) or v > 60.0 * 1e-6 for v in floors.values())
+    probes, prev = {"P_all": -9.0237e-6, "P": 60.1}, {"P_all": 2.7479e-6, "P": 15.0}
+    msgs = jump_warnings(27, 0.4263, 0.42, None, None, probes, prev, None, 3.0, None, floors)
+    assert len(msgs) == 1 and "'P'" in msgs[0]  # P grew 4x while λ hardly changed: still a jump
 
 
 # ---------------------------------------------------------------------- process-zone length

@@ -346,11 +346,19 @@ class CohesiveBlock:
     lam_old: float = 0.0  # load factor of the last commit
     lam_trial: float = 0.0  # load factor of the current solve (Problem.external)
     last_inviscid: np.ndarray | None = None  # rate-independent damage of the last point_state
+    # pseudo-time added to the load-factor time of the viscous law, so that the damage can relax
+    # at a fixed load (solver/newton.py relax: a load step past a snap-back)
+    relax_time: float = 0.0
     symmetric = False
     #: the last tangent was exactly symmetric at every point (M_q = M_qᵀ: no growing damage in a
     #: mixed mode, e.g. a pure mode I DCB), so K is symmetric to round-off and the assembler can
     #: skip the solver's O(nnz) symmetry check (``Assembler.symmetric``); False before a tangent
     symmetric_now = False
+    #: the last tangent's point matrices are unsymmetric by more than UNSYMMETRIC_RTOL of their
+    #: largest entry (damage growing in a mixed mode or off the normal): the solver takes its
+    #: general mode without the O(nnz) symmetry check of K_r
+    unsymmetric_now = False
+    UNSYMMETRIC_RTOL = 1e-6
     compact_tangent = False
     smooth_when_frozen = True  # newton(): no residual line search in the active-set loop
 
@@ -493,7 +501,7 @@ class CohesiveBlock:
         t, d, D, dd = point_response(delta, n, self.d_old, self.K, self.law, True, True, self.frozen)
         self.last_inviscid = d
         if self.law.viscosity > 0:
-            r = max(self.lam_trial - self.lam_old, 0.0) / self.law.viscosity
+            r = (max(self.lam_trial - self.lam_old, 0.0) + self.relax_time) / self.law.viscosity
             dv_old = self.d_old if self.dv_old is None else self.dv_old
             dv = (dv_old + r * d) / (1.0 + r)
             grow = dv > dv_old
@@ -544,7 +552,9 @@ class CohesiveBlock:
         if friction:
             M = M + d[..., None, None] * Df + tf[..., :, None] * dd[..., None, :]
         M = cb.w[..., None, None] * M
-        self.symmetric_now = not np.any(M != M.swapaxes(-1, -2))
+        asym = np.abs(M - M.swapaxes(-1, -2)).max() if M.size else 0.0
+        self.symmetric_now = asym == 0.0
+        self.unsymmetric_now = bool(asym > self.UNSYMMETRIC_RTOL * np.abs(M).max()) if M.size else False
         if points:
             return cb.point_matrices(cb.w[..., None] * T, M)
         c = cb.c

@@ -971,6 +971,13 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         notes.append("every [[loads]] entry is zero (magnitude, distribution or value 0), so every displacement, "
                      "stress and probe value is zero; give the loads their values")
     st = mf.steps
+    if st.unstable == "relax" and st.stabilize > 0:
+        raise InputError("'steps.unstable' = 'relax' and 'steps.stabilize' > 0 both handle a step without "
+                         "equilibrium: relax lets the damage snap to the next equilibrium at that load, stabilize "
+                         "keeps a viscous law on from there; choose one (remove the other key)")
+    if st.unstable == "relax" and st.control == "arc_length":
+        raise InputError("'steps.unstable' = 'relax' acts on load steps (control = 'load'); arc-length control "
+                         "follows a snap-back along the path itself: remove 'unstable', or use control = 'load'")
     if st.factors is not None:
         lf = np.asarray(st.factors, float)
         if lf.size == 0:
@@ -983,7 +990,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
                             max_bisections=st.max_bisections, backend=st.solver,
                             max_contact_iterations=st.max_contact_iterations, stabilize=st.stabilize,
-                            stabilize_limit=st.stabilize_limit)
+                            stabilize_limit=st.stabilize_limit, unstable=st.unstable)
     _interfaces(mf, model, index, layers)
     from .probes import build_probes
 

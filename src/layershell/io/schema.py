@@ -393,6 +393,15 @@ class Steps(Strict):
         0.05, gt=0, le=1, description="stabilised runs stop at a step whose viscous dissipation exceeds this "
         "share of the step's dissipation: the regularisation, not the interface, then carries the load, past a "
         "limit point of the load or a snap-back; follow the path with control = 'arc_length' or refine the mesh")
+    unstable: Literal["stop", "relax"] = Field(
+        "stop", description="control = 'load' (fixed or adaptive steps) with cohesive interfaces: a step that "
+        "fails through all its bisections (cuts) has no equilibrium of the rate-independent law nearby - a "
+        "snap-back of the path under displacement control (the crack front jumps), or a limit point under force "
+        "control. 'relax': the damage relaxes at the load of the smallest cut to the next equilibrium (a viscous "
+        "law in pseudo-time at the fixed load, until it holds without viscosity), as a specimen snaps in a test; "
+        "the energy the jump releases is booked as viscous dissipation, each jump is a warning and an entry of "
+        "summary.json 'relaxations'; where the interfaces separate completely (a limit point) the run stops. "
+        "'stop' (default): the run stops at such a step")
     solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
         "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
     control: Literal["load", "arc_length"] = Field(

@@ -38,7 +38,8 @@ import numpy as np
 
 from . import linear
 from .newton import (ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
-                     check_stabilised_step, dissipation_so_far, newton, stabilise, stagnates)
+                     check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax, stabilise,
+                     stagnates)
 from .problem import Problem
 
 
@@ -68,6 +69,9 @@ class PathSettings:
     stall_increments: int = 25
     max_cuts: int = 12
     max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
+    # NewtonSettings.unstable = "relax", load control: relax at the load of the increment after
+    # this many cuts (or at the last cut)
+    relax_after_cuts: int = 4
     jump_area: float | None = 0.2
     jump_ratio: float | None = 3.0
 
@@ -395,6 +399,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         residuals: list[float] = []
         allow_jump = tried_dissipation = False
         warns: list[str] = []
+        size0 = st.size
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
@@ -470,6 +475,17 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
             jump = msg in ("debonding jump", "probe jump")
+            if (st.mode == "load" and s.unstable == "relax" and not jump and cuts > ps.relax_after_cuts
+                    and not (cuts > ps.max_cuts or small)):
+                # a step without equilibrium nearby fails at every size (the 100-element DCB spent
+                # ~100 iterations on each of up to 20 cuts of the step before a snap-back): relax
+                rel = relax(problem, u, lam, lam + st.size, s, on_step_end)
+                if rel is not None:
+                    att = Attempt(True, rel.u, rel.load_factor, rel.iterations, rel.residuals)
+                    total_it += rel.iterations
+                    residuals += rel.residuals
+                    st.size = size0  # the jump is behind: the size before the cuts, halved below
+                    break
             if cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts):
                 if jump:
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
@@ -480,11 +496,20 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
+                if st.mode == "load" and s.unstable == "relax":
+                    rel = relax(problem, u, lam, lam + st.size, s, on_step_end)  # the next equilibrium at this load
+                    if rel is not None:
+                        att = Attempt(True, rel.u, rel.load_factor, rel.iterations, rel.residuals)
+                        total_it += rel.iterations
+                        residuals += rel.residuals
+                        st.size = size0  # the jump is behind: the size before the cuts, halved below
+                        break
                 if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
                     cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
                     continue
                 raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
-                                       f"cuts ({msg}); the last converged load factor is {lam:.6g}",
+                                       f"cuts ({msg}); the last converged load factor is {lam:.6g}"
+                                       + (cohesive_hint(problem, s) if st.mode == "load" else ""),
                                        lam, residuals[-1] if residuals else float("nan"))
             st.size *= 0.5
         # accepted increment

@@ -161,6 +161,10 @@ class InterfaceController:
     mesh_nodes: np.ndarray | None = None  # for plots
     new_warnings: list = field(default_factory=list)  # warnings of the last update (cohesive process zone)
     stabilized: dict | None = None  # automatic viscous stabilisation: {load_factor, viscosity} (stabilize)
+    # relaxations at a fixed load past a snap-back or limit point (unstable = "relax", solver/newton.py
+    # relax): one dict per event, and the runs whose viscous law a relaxation has switched on
+    relaxations: list = field(default_factory=list)
+    relaxing: list = field(default_factory=list, repr=False)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
     f_last: np.ndarray | None = None  # [external force, layers' internal force] there
@@ -427,6 +431,49 @@ class InterfaceController:
             r.block.dv_old = np.array(r.block.dv_old if r.block.dv_old is not None else r.block.d_old, copy=True)
         self.stabilized = {"load_factor": float(lam), "viscosity": float(eta)}
         return True
+
+    def relax_begin(self) -> bool:
+        """Switch on the viscous law (Gao & Bower 2004) with the unit time η = 1 on every cohesive
+        interface that has none, for a relaxation at a fixed load (:func:`~layershell.solver.
+        newton.relax`): the pseudo-time of its increments is ``CohesiveBlock.relax_time``. The
+        acting damage starts equal to the rate-independent one. False: nothing to switch on."""
+        coh = [r for r in self.runs if isinstance(r, CohesiveRun) and r.law.viscosity == 0]
+        for r in coh:
+            r.law = replace(r.law, viscosity=1.0)
+            r.block.law = r.law
+            r.block.dv_old = np.array(r.block.dv_old if r.block.dv_old is not None else r.block.d_old, copy=True)
+            r.block.relax_time = 0.0
+        self.relaxing = coh
+        return bool(coh)
+
+    def relax_time(self, dt: float) -> None:
+        """The pseudo-time of the next relaxation increment (in units of η = 1)."""
+        for r in self.relaxing:
+            r.block.relax_time = float(dt)
+
+    def viscous_lag(self) -> float:
+        """max |d - d_v| of the relaxing interfaces at their last commit: how far the acting
+        damage still lags behind the rate-independent one (0: relaxed)."""
+        return max((float(np.abs(r.block.d_old - r.block.dv_old).max()) if r.block.d_old.size else 0.0
+                    for r in self.relaxing), default=0.0)
+
+    def damage_change(self, u: np.ndarray) -> float:
+        """max |d(u) - d_old| over the cohesive interfaces: how much the rate-independent damage
+        at ``u`` differs from the last commit's."""
+        out = 0.0
+        for r in self.runs:
+            if isinstance(r, CohesiveRun) and r.block.d_old.size:
+                r.block.point_state(u)
+                out = max(out, float(np.abs(r.block.last_inviscid - r.block.d_old).max()))
+        return out
+
+    def relax_end(self) -> None:
+        """Back to the rate-independent law on the interfaces :meth:`relax_begin` switched."""
+        for r in self.relaxing:
+            r.law = replace(r.law, viscosity=0.0)
+            r.block.law = r.law
+            r.block.relax_time = 0.0
+        self.relaxing = []
 
     def cohesive(self) -> bool:
         """Whether any interface has the cohesive law."""
