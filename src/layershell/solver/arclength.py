@@ -475,10 +475,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
             jump = msg in ("debonding jump", "probe jump")
-            if (st.mode == "load" and s.unstable == "relax" and not jump and cuts > ps.relax_after_cuts
-                    and not (cuts > ps.max_cuts or small)):
+            limit = cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts)
+            if st.mode == "load" and s.unstable == "relax" and not jump and (cuts > ps.relax_after_cuts or limit):
                 # a step without equilibrium nearby fails at every size (the 100-element DCB spent
                 # ~100 iterations on each of up to 20 cuts of the step before a snap-back): relax
+                # at the load of the smallest cut to the next equilibrium
                 rel = relax(problem, u, lam, lam + st.size, s, on_step_end)
                 if rel is not None:
                     att = Attempt(True, rel.u, rel.load_factor, rel.iterations, rel.residuals)
@@ -486,7 +487,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     residuals += rel.residuals
                     st.size = size0  # the jump is behind: the size before the cuts, halved below
                     break
-            if cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts):
+            if limit:
                 if jump:
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
                     continue
@@ -496,14 +497,6 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
-                if st.mode == "load" and s.unstable == "relax":
-                    rel = relax(problem, u, lam, lam + st.size, s, on_step_end)  # the next equilibrium at this load
-                    if rel is not None:
-                        att = Attempt(True, rel.u, rel.load_factor, rel.iterations, rel.residuals)
-                        total_it += rel.iterations
-                        residuals += rel.residuals
-                        st.size = size0  # the jump is behind: the size before the cuts, halved below
-                        break
                 if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
                     cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
                     continue
