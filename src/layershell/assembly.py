@@ -195,21 +195,18 @@ class ReducedScatter:
             w_all[s0:s1] = tv[ta] * tv[tb]
         return q_all, w_all
 
-    def matrix(self, data_full: np.ndarray, symmetric: bool = False, unsymmetric: bool = False) -> "ReducedTangent":
+    def matrix(self, data_full: np.ndarray, symmetric: bool = False) -> "ReducedTangent":
         """K_r for the values ``data_full`` of the full-space pattern; ``symmetric``: every
-        contribution is symmetric by construction (no check needed by the solver);
-        ``unsymmetric``: a contribution is known to be clearly unsymmetric (no check either)."""
-        return self.matrix_from_values(self.P @ data_full, symmetric, unsymmetric)
+        contribution is symmetric by construction (no check needed by the solver)."""
+        return self.matrix_from_values(self.P @ data_full, symmetric)
 
-    def matrix_from_values(self, data_reduced: np.ndarray, symmetric: bool = False,
-                           unsymmetric: bool = False) -> "ReducedTangent":
+    def matrix_from_values(self, data_reduced: np.ndarray, symmetric: bool = False) -> "ReducedTangent":
         """K_r with the values ``data_reduced`` of this pattern."""
         K = ReducedTangent((data_reduced, self.indices, self.indptr), shape=self.shape)
         K.indices, K.indptr = self.indices, self.indptr  # share (SciPy may copy them): no copy per iteration
         K.has_sorted_indices = True
         K.scatter = self
         K.known_symmetric = symmetric
-        K.known_unsymmetric = unsymmetric and not symmetric
         return K
 
     def memory_bytes(self) -> int:
@@ -230,10 +227,6 @@ class ReducedTangent(sp.csr_matrix):
     #: ``symmetric``): the solver skips its O(nnz) symmetry check. Cleared when ``data`` is
     #: changed by hand.
     known_symmetric: bool = False
-    #: a contribution is clearly unsymmetric (``Assembler.unsymmetric``): the solver takes its
-    #: general mode without the check. Cleared, like ``known_symmetric``, when ``data`` is
-    #: changed by hand.
-    known_unsymmetric: bool = False
 
     def _maps(self) -> ReducedScatter | None:
         rs = self.scatter
@@ -517,7 +510,7 @@ class Assembler:
         bulk = self._linear_bulk()
         if bulk is None:
             f, data = self._values(u_full, True)
-            return f, rs.matrix(data, symmetric=self.symmetric, unsymmetric=self.unsymmetric)
+            return f, rs.matrix(data, symmetric=self.symmetric)
         if bulk.reduced is None or bulk.reduced[0] is not rs:  # P @ K_bulk once per operator
             bulk.reduced = None
             Pt = rs.P[:, bulk.touched].tocsr()
@@ -528,7 +521,7 @@ class Assembler:
         data = bulk.buffer(base.size)
         np.copyto(data, base)
         data[rows] += Pt @ extra
-        K = rs.matrix_from_values(data, symmetric=self.symmetric, unsymmetric=self.unsymmetric)
+        K = rs.matrix_from_values(data, symmetric=self.symmetric)
         bulk.lend(data, K)
         return f, K
 
@@ -538,11 +531,3 @@ class Assembler:
         geometric term), extra blocks declare it (``symmetric = True``, or ``symmetric_now`` for
         the tangent they gave last)."""
         return all(getattr(b, "symmetric", False) or getattr(b, "symmetric_now", False) for b in self.extra)
-
-    @property
-    def unsymmetric(self) -> bool:
-        """An extra block's last tangent is clearly unsymmetric (``unsymmetric_now``: by more than
-        10⁻⁶ of its own largest entry, far above the solver's 10⁻¹² of K's): the solver skips its
-        symmetry check of K_r and factorises it as a general matrix (wrong only towards the
-        slower, still exact, LU)."""
-        return any(getattr(b, "unsymmetric_now", False) for b in self.extra)

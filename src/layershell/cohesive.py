@@ -354,11 +354,6 @@ class CohesiveBlock:
     #: mixed mode, e.g. a pure mode I DCB), so K is symmetric to round-off and the assembler can
     #: skip the solver's O(nnz) symmetry check (``Assembler.symmetric``); False before a tangent
     symmetric_now = False
-    #: the last tangent's point matrices are unsymmetric by more than UNSYMMETRIC_RTOL of their
-    #: largest entry (damage growing in a mixed mode or off the normal): the solver takes its
-    #: general mode without the O(nnz) symmetry check of K_r
-    unsymmetric_now = False
-    UNSYMMETRIC_RTOL = 1e-6
     compact_tangent = False
     smooth_when_frozen = True  # newton(): no residual line search in the active-set loop
 
@@ -552,9 +547,7 @@ class CohesiveBlock:
         if friction:
             M = M + d[..., None, None] * Df + tf[..., :, None] * dd[..., None, :]
         M = cb.w[..., None, None] * M
-        asym = np.abs(M - M.swapaxes(-1, -2)).max() if M.size else 0.0
-        self.symmetric_now = asym == 0.0
-        self.unsymmetric_now = bool(asym > self.UNSYMMETRIC_RTOL * np.abs(M).max()) if M.size else False
+        self.symmetric_now = not np.any(M != M.swapaxes(-1, -2))
         if points:
             return cb.point_matrices(cb.w[..., None] * T, M)
         c = cb.c

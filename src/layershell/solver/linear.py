@@ -5,9 +5,7 @@ x86-64), used in its *real symmetric indefinite* mode (mtype = -2, upper triangl
 tangent is symmetric - it is not always positive definite (buckling, limit points) - and in its
 general mode (mtype = 11) where it is not. Assembled tangents whose contributions are all
 symmetric by construction (element tangents, contact with the exact friction return mapping)
-say so (``ReducedTangent.known_symmetric``), those with a clearly unsymmetric contribution (a
-cohesive interface whose damage grows off the normal) too (``known_unsymmetric``); other
-matrices are checked on every call (O(nnz)).
+say so (``ReducedTangent.known_symmetric``); other matrices are checked on every call (O(nnz)).
 The symbolic analysis (fill-reducing ordering) is kept and reused while the sparsity pattern
 does not change - every Newton iteration of a bond state has the same pattern - and only the
 numerical factorisation is redone. PARDISO is called with explicit parameters (MKL's
@@ -93,8 +91,6 @@ def is_symmetric(K: sp.spmatrix, rtol: float = 1e-12) -> bool:
     symmetric)."""
     if getattr(K, "known_symmetric", False):  # assembly.ReducedTangent of symmetric contributions
         return True
-    if getattr(K, "known_unsymmetric", False):  # ... with a clearly unsymmetric one (a damaging cohesive block)
-        return False
     fast = getattr(K, "symmetry_check", None)  # assembly.ReducedTangent: one O(nnz) pass via its pattern maps
     check = fast() if fast is not None else None
     if check is not None:
