@@ -37,8 +37,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import (ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
-                     check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax, stabilise,
+from .newton import (RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks,
+                     at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax, stabilise,
                      stagnates)
 from .problem import Problem
 
@@ -71,7 +71,7 @@ class PathSettings:
     max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
     # NewtonSettings.unstable = "relax", load control: relax at the load of the increment after
     # this many cuts (or at the last cut)
-    relax_after_cuts: int = 4
+    relax_after_cuts: int = RELAX_AFTER_CUTS
     jump_area: float | None = 0.2
     jump_ratio: float | None = 3.0
 

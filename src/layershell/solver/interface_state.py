@@ -422,29 +422,29 @@ class InterfaceController:
         bisections (``NewtonSettings.stabilize``). The acting damage starts equal to the
         rate-independent one, so the converged state is unchanged; the viscous share of the
         dissipation is booked in the energy ledger. False: nothing to switch on."""
-        coh = [r for r in self.runs if isinstance(r, CohesiveRun) and r.law.viscosity == 0]
-        if not coh or not eta > 0:
+        if not eta > 0 or not self._viscous_on(eta):
             return False
+        self.stabilized = {"load_factor": float(lam), "viscosity": float(eta)}
+        return True
+
+    def _viscous_on(self, eta: float) -> list:
+        """Switch the viscous law with the time ``eta`` on at every cohesive interface that has
+        none, the acting damage starting at the rate-independent one; returns those runs."""
+        coh = [r for r in self.runs if isinstance(r, CohesiveRun) and r.law.viscosity == 0]
         for r in coh:
             r.law = replace(r.law, viscosity=float(eta))
             r.block.law = r.law
             r.block.dv_old = np.array(r.block.dv_old if r.block.dv_old is not None else r.block.d_old, copy=True)
-        self.stabilized = {"load_factor": float(lam), "viscosity": float(eta)}
-        return True
+            r.block.relax_time = 0.0
+        return coh
 
     def relax_begin(self) -> bool:
         """Switch on the viscous law (Gao & Bower 2004) with the unit time η = 1 on every cohesive
         interface that has none, for a relaxation at a fixed load (:func:`~layershell.solver.
         newton.relax`): the pseudo-time of its increments is ``CohesiveBlock.relax_time``. The
         acting damage starts equal to the rate-independent one. False: nothing to switch on."""
-        coh = [r for r in self.runs if isinstance(r, CohesiveRun) and r.law.viscosity == 0]
-        for r in coh:
-            r.law = replace(r.law, viscosity=1.0)
-            r.block.law = r.law
-            r.block.dv_old = np.array(r.block.dv_old if r.block.dv_old is not None else r.block.d_old, copy=True)
-            r.block.relax_time = 0.0
-        self.relaxing = coh
-        return bool(coh)
+        self.relaxing = self._viscous_on(1.0)
+        return bool(self.relaxing)
 
     def relax_time(self, dt: float) -> None:
         """The pseudo-time of the next relaxation increment (in units of η = 1)."""

@@ -590,7 +590,6 @@ class Relaxation:
     load_factor: float
     iterations: int
     residuals: list[float]
-    record: dict  # InterfaceController.relaxations entry
 
 
 def relax(problem: Problem, u: np.ndarray, lam_from: float, lam: float, s: NewtonSettings,
@@ -605,8 +604,8 @@ def relax(problem: Problem, u: np.ndarray, lam_from: float, lam: float, s: Newto
     committed (``on_step_end``), until the acting damage d_v is within RELAX_LAG of the
     rate-independent damage d everywhere. Then the law is switched back and the state must be an
     equilibrium of the rate-independent law: a Newton solve at ``lam`` that converges there with
-    its damage within RELAX_LAG of the relaxed one ends the relaxation (else it relaxes on). This is the dynamic snap of a displacement-controlled
-    test at a snap-back (or the collapse of a force-controlled one past a limit point) without
+    its damage within RELAX_LAG of the relaxed one ends the relaxation (else it relaxes on). This
+    is the dynamic snap of a displacement-controlled test at a snap-back (or the collapse of a force-controlled one past a limit point) without
     inertia: the energy the jump releases is dissipated by the viscous law, booked as
     ``dissipated_viscous`` in the energy ledger, and recorded per event
     (``InterfaceController.relaxations``: load factors, increments, the released energy, the
@@ -632,47 +631,48 @@ def relax(problem: Problem, u: np.ndarray, lam_from: float, lam: float, s: Newto
             f"no equilibrium of the cohesive law beyond load factor {lam_from:.6g}, and the relaxation of the "
             f"damage at load factor {lam:.6g} failed: {reason}", lam_from, residuals[-1] if residuals else float("nan"))
 
+    def solve(u_from: np.ndarray) -> tuple[np.ndarray, NewtonResult]:
+        nonlocal its
+        u_to, res = newton(problem, u_from, lam, s)
+        its += res.iterations
+        residuals.extend(res.residuals)
+        return u_to, res
+
+    def commit(u_c: np.ndarray) -> np.ndarray:
+        """Commit the damage (and any other interface state), re-solving where it asks to."""
+        while on_step_end(problem, u_c, lam):
+            u_c, res = solve(u_c)
+            if not res.converged:
+                raise fail(f"re-equilibration failed ({res.message})")
+        return u_c
+
     for k in range(1, RELAX_MAX_INCREMENTS + 1):
         ctl.relax_time(dt)
-        u_new, res = newton(problem, u, lam, s)
-        its += res.iterations
-        residuals += res.residuals
+        u_new, res = solve(u)
         if not res.converged:
             dt *= 0.25
             if dt < RELAX_DT_MIN:
                 why = f"no equilibrium even for a pseudo-time step of {dt:.1e} ({res.message})"
                 break
             continue
-        while on_step_end(problem, u_new, lam):  # commits the damage (and any other interface state)
-            u_new, res = newton(problem, u_new, lam, s)
-            its += res.iterations
-            residuals += res.residuals
-            if not res.converged:
-                raise fail(f"re-equilibration failed ({res.message})")
-        u = u_new
+        u = commit(u_new)
         if ctl.debonded_fraction() >= 1.0 - 1e-9:
             why = "the interfaces separated completely: the structure cannot carry this load (a limit point)"
             break
         if ctl.viscous_lag() <= RELAX_LAG:
             ctl.relax_end()  # relaxed: does the rate-independent law hold here?
-            u_ri, res = newton(problem, u, lam, s)
-            its += res.iterations
-            residuals += res.residuals
+            u_ri, res = solve(u)
             # ... and without moving on: a solve that converges to more damage has found the rest
             # of the jump, whose released energy no ledger would see (the 100-element DCB: two
             # jumps with 1.0 of their 1.1 units of energy there, the balance error 1.5 %)
             if res.converged and ctl.damage_change(u_ri) <= RELAX_LAG:
-                while on_step_end(problem, u_ri, lam):
-                    u_ri, res = newton(problem, u_ri, lam, s)
-                    its += res.iterations
-                    residuals += res.residuals
-                    if not res.converged:
-                        raise fail(f"re-equilibration failed ({res.message})")
-                record = {"load_factor": float(lam), "from_load_factor": float(lam_from), "increments": k,
-                          "iterations": its, "energy_released": ctl.dissipation()[1] - viscous0,
-                          "debonded_fraction_before": area0, "debonded_fraction_after": ctl.debonded_fraction()}
-                ctl.relaxations.append(record)
-                return Relaxation(u_ri, lam, its, residuals, record)
+                u_ri = commit(u_ri)
+                ctl.relaxations.append({"load_factor": float(lam), "from_load_factor": float(lam_from),
+                                        "increments": k, "iterations": its,
+                                        "energy_released": ctl.dissipation()[1] - viscous0,
+                                        "debonded_fraction_before": area0,
+                                        "debonded_fraction_after": ctl.debonded_fraction()})
+                return Relaxation(u_ri, lam, its, residuals)
             ctl.relax_begin()  # not yet an equilibrium of the rate-independent law: relax on
         dt = min(2.0 * dt, RELAX_DT_MAX)
     raise fail(why)
