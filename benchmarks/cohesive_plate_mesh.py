@@ -3,9 +3,13 @@ examples/cantilever_plate_cohesive.toml (and, with --thesis, cantilever_plate_st
 thesis's law) on the meshes given and prints first damage / first full debonding / w_front_max.
 
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 6 12 24 [--thesis] [--beyond]
+    PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 24 --element mitc --reuse never
 
 ``--beyond``: load past the design load to λ = 1.2 (steps of 0.1 to 0.9, then 0.01), where the
 interface debonds completely at a first point (first_delamination_load_factor).
+``--element mitc``: the MITC9 element instead of the example's; ``--reuse never|always``: the
+linear solver's ``[steps] reuse_factorization`` (default auto: GMRES on kept factorisations;
+the printed ``linear_solves`` count them).
 """
 from __future__ import annotations
 
@@ -19,15 +23,19 @@ from layershell.runner import run
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def study(name: str, n: int, beyond: bool = False) -> dict:
+def study(name: str, n: int, beyond: bool = False, element: str | None = None, reuse: str | None = None) -> dict:
     path = EXAMPLES / f"{name}.toml"
     text = path.read_text()
+    if element is not None:
+        text = text.replace('element = "full"', f'element = "{element}"')
     for key in ("nx", "ny"):
         for old in (3, 6):
             text = text.replace(f"{key} = {old}\n", f"{key} = {n}\n")
     if beyond:
         factors = [round(0.1 * i, 4) for i in range(1, 10)] + [round(0.9 + 0.01 * i, 4) for i in range(1, 31)]
         text = text.replace("[steps]\nn = 24", f"[steps]\nfactors = {factors}")
+    if reuse is not None:
+        text = text.replace("[steps]\n", f'[steps]\nreuse_factorization = "{reuse}"\n', 1)
     t0, c0 = time.perf_counter(), time.process_time()
     s = run(build(parse(text, str(path)), path.parent), None, write_vtu=False).summary
     return {"mesh": f"{n}x{n}", "lambda_end": s["steps"][-1]["load_factor"] if s["steps"] else 0.0,
@@ -36,16 +44,23 @@ def study(name: str, n: int, beyond: bool = False) -> dict:
             "w_front_max": s["probes"].get("w_front_max"), "wall_s": round(time.perf_counter() - t0, 1),
             "cpu_s": round(time.process_time() - c0, 1),
             "iterations": sum(st["iterations"] for st in s["steps"]), "error": s.get("error"),
-            "stabilized": s.get("stabilized"), "balance": (s.get("energy") or {}).get("balance_error")}
+            "stabilized": s.get("stabilized"), "balance": (s.get("energy") or {}).get("balance_error"),
+            "linear_solves": s.get("linear_solves")}
 
 
 def main(argv: list[str]) -> None:
+    opts = {}
+    for flag in ("--element", "--reuse"):
+        if flag in argv:
+            i = argv.index(flag)
+            opts[flag[2:]] = argv[i + 1]
+            argv = argv[:i] + argv[i + 2:]
     meshes = [int(a) for a in argv if a.isdigit()] or [6, 12]
     names = ["cantilever_plate_cohesive"] + (["cantilever_plate_strong"] if "--thesis" in argv else [])
     for name in names:
         print(name)
         for n in meshes:
-            print("  ", study(name, n, "--beyond" in argv), flush=True)
+            print("  ", study(name, n, "--beyond" in argv, **opts), flush=True)
 
 
 if __name__ == "__main__":

@@ -565,6 +565,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                 if getattr(problem, "accepted_sets", 0):  # cohesive active sets accepted within their tolerance (solver/newton.py)
                     summary["active_set"] = {"accepted_within_tolerance": problem.accepted_sets,
                                              "largest_violation": problem.accepted_violation}
+                counts = problem.solve_counts() if hasattr(problem, "solve_counts") else {}
+                if counts.get("krylov_solves") or counts.get("krylov_failures"):  # solver/linear.py reuse
+                    summary["linear_solves"] = counts
                 summary["steps"].append(rec)
                 zones.record(st.step, st.load_factor)
                 summary["probes"] = vals

@@ -989,6 +989,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                          "pypardiso; x86-64 only); install it or use solver = 'auto' or 'superlu'")
     newton = NewtonSettings(tol_residual=st.tolerance, max_iterations=st.max_iterations,
                             max_bisections=st.max_bisections, backend=st.solver,
+                            reuse_factorization=st.reuse_factorization,
                             max_contact_iterations=st.max_contact_iterations, stabilize=st.stabilize,
                             stabilize_limit=st.stabilize_limit, unstable=st.unstable)
     _interfaces(mf, model, index, layers)

@@ -404,6 +404,12 @@ class Steps(Strict):
         "'stop' (default): the run stops at such a step")
     solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
         "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
+    reuse_factorization: Literal["auto", "always", "never"] = Field(
+        "auto", description="PARDISO: solve a Newton iteration's tangent first by GMRES preconditioned with the "
+        "last factorisation (of an earlier iteration), and factorise only where GMRES would spend more than a "
+        "factorisation costs; 'auto' (default): on models whose factorisation costs at least 16 GMRES "
+        "iterations (about 15 000 DOFs and up), 'always', 'never'. The answer is the same to the Newton "
+        "tolerance; summary.json 'linear_solves' counts factorisations and GMRES solves")
     control: Literal["load", "arc_length"] = Field(
         "load", description="'load': the load factor λ is stepped (it scales forces and prescribed support "
         "displacements alike: displacement control is a [[supports]] 'fix' with 'value'); 'arc_length': λ is an "

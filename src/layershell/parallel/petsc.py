@@ -301,9 +301,9 @@ class DistributedProblem:
             raise UnsupportedModelError("the bond state changed during a distributed run; bond releases "
                                         "(thesis-law interfaces) are not distributed yet")
 
-    def linear_solver(self, backend: str = "auto") -> "_Solver":
-        """The PETSc KSP as :class:`layershell.solver.linear.LinearSolver` (``backend`` is ignored:
-        the KSP set up from ``solver`` and the ``-ls_`` options)."""
+    def linear_solver(self, backend: str = "auto", reuse: str = "auto") -> "_Solver":
+        """The PETSc KSP as :class:`layershell.solver.linear.LinearSolver` (``backend`` and
+        ``reuse`` are ignored: the KSP set up from ``solver`` and the ``-ls_`` options)."""
         return _Solver(self)
 
     def internal_force(self, u_full: np.ndarray, tangent: bool) -> np.ndarray:

@@ -168,7 +168,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     loop.freeze(u0)
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
-    solver = problem.linear_solver(s.backend)
+    solver = problem.linear_solver(s.backend, s.reuse_factorization)
     att = Attempt(False, u0, lam0, 0)
     try:
         _, Kr = asm.evaluate_reduced(u0, op)
@@ -234,7 +234,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     qq = float(q @ q)
     nq = math.sqrt(qq)
     Fc_r = op.reduce(problem.F_const)
-    solver = problem.linear_solver(s.backend)
+    solver = problem.linear_solver(s.backend, s.reuse_factorization)
     start = att.iterations
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
     e0: float | None = None
@@ -634,5 +634,5 @@ def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -
 def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: PathSettings) -> float:
     """‖w ∘ δu_r‖ (:func:`arc_weights`) of the linear predictor for the load increment ``ps.increment``."""
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op)
-    dut = problem.linear_solver(s.backend).solve(Kr, problem.op.reduce(problem.F_scaled))
+    dut = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, problem.op.reduce(problem.F_scaled))
     return abs(ps.increment) * float(np.linalg.norm(dut * arc_weights(problem)))

@@ -32,6 +32,8 @@ class NewtonSettings:
     max_iterations: int = 25
     max_bisections: int = 8
     backend: str = "auto"
+    # GMRES on the last factorisation before a new one (solver/linear.py LinearSolver ``reuse``)
+    reuse_factorization: str = "auto"
     max_active_set_loops: int = 12
     # contact: first up to this many semi-smooth iterations (contact set from the current gap in
     # every iteration); if they do not converge, the frozen active-set loop (see ``newton``)
@@ -389,7 +391,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
         # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
         _, Kr = asm.evaluate_reduced(u, op)
         try:
-            du = problem.linear_solver(s.backend).solve(Kr, r)
+            du = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, r)
         except linear.SingularSystemError as exc:
             res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
             return u, res

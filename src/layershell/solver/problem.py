@@ -24,7 +24,7 @@ class Problem:
     F_friction: np.ndarray | None = None
     extra_blocks: list = field(default_factory=list)
     interfaces: object = None  # InterfaceController when the model has interface laws
-    solvers: dict = field(default_factory=dict, repr=False)  # backend -> LinearSolver
+    solvers: dict = field(default_factory=dict, repr=False)  # (backend, reuse) -> LinearSolver
     # PARDISO's ordering choice per sparsity pattern, kept when the solvers are started afresh
     orderings: dict = field(default_factory=dict, repr=False)
     # the largest force scale (applied loads or reactions) of a converged state so far: a floor
@@ -65,15 +65,25 @@ class Problem:
         self.op = constraint_operator(self.model, self.dm, self.bonded)
         self.op_bonded = {k: v.copy() for k, v in self.bonded.items()}
 
-    def linear_solver(self, backend: str = "auto"):
-        """This problem's linear solver (keeps PARDISO's symbolic analysis between iterations)."""
+    def linear_solver(self, backend: str = "auto", reuse: str = "auto"):
+        """This problem's linear solver (keeps PARDISO's symbolic analysis between iterations and,
+        with ``reuse``, its last factorisation as GMRES's preconditioner)."""
         from .linear import LinearSolver
 
-        if backend not in self.solvers:
+        key = (backend, reuse)
+        if key not in self.solvers:
             # PARDISO's symmetric mode wherever K_r is symmetric (checked per call); friction
             # tangents that are not fall back to the general mode
-            self.solvers[backend] = LinearSolver(backend, symmetric=True, decisions=self.orderings)
-        return self.solvers[backend]
+            self.solvers[key] = LinearSolver(backend, symmetric=True, decisions=self.orderings, reuse=reuse)
+        return self.solvers[key]
+
+    def solve_counts(self) -> dict:
+        """Factorisations and GMRES solves of this problem's linear solvers (summary.json)."""
+        out: dict = {}
+        for sol in self.solvers.values():
+            for k, v in sol.counts.as_dict().items():
+                out[k] = out.get(k, 0) + v
+        return out
 
     def snapshot(self) -> dict:
         """Copy of the mutable delamination state (bond flags, per-point history, friction
