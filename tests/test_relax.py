@@ -170,3 +170,37 @@ def test_enf_on_200_elements_reaches_its_end_with_relaxation_settings():
     assert np.all(np.abs(ratio - 1) < 0.03), ratio
     assert P[pk] == pytest.approx(721.3, rel=0.015)  # the 100-element peak (tests/test_enf.py)
     assert abs(r.summary["energy"]["balance_error"]) < 0.01
+
+
+@pytest.mark.slow
+def test_restart_after_a_relaxed_step_repeats_the_uninterrupted_run(tmp_path):
+    """A run whose step 7 was relaxed (the jump above), interrupted after that step and restarted
+    from its checkpoint, ends where the uninterrupted run ends: displacements, the load probe, the
+    energy ledger (the jump's energy booked as viscous dissipation before the restart) and the
+    summary's 'relaxations' (the jump recorded once). The reference is the same model run without
+    interruption (about 1 min)."""
+    from layershell.runner import run
+
+    spec = build(parse(_dcb_text(100, 'unstable = "relax"\nfactors = [0.3, 0.4, 0.44, 0.47, 0.5, 0.51, 0.52, 0.525]'),
+                       str(EXAMPLES / "dcb.toml")), EXAMPLES)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    assert full.converged
+
+    def stop(i, n, lam):
+        if i == 7:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted and len(part.summary["steps"]) == 7
+    assert [r["step"] for r in part.summary["relaxations"]] == [7]
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-10 * abs(full.u).max())
+    a, b = full.summary, again.summary
+    assert [r["step"] for r in b["relaxations"]] == [r["step"] for r in a["relaxations"]]
+    assert b["relaxations"][0]["energy_released"] == pytest.approx(a["relaxations"][0]["energy_released"], rel=1e-10)
+    for sa, sb in zip(a["steps"], b["steps"]):
+        assert sb["probes"]["P"] == pytest.approx(sa["probes"]["P"], rel=1e-9)
+    for k in ("external_work", "dissipated_fracture", "dissipated_viscous", "balance_error"):
+        assert b["energy"][k] == pytest.approx(a["energy"][k], rel=1e-8, abs=1e-12), k
+    assert b["energy"]["dissipated_viscous"] > 0

@@ -85,12 +85,17 @@ def _jsonable(obj):
     return obj
 
 
+#: the summary entries a checkpoint carries to the restarted run (the run's history up to it:
+#: the stabilisation and the relaxed jumps included - a restart once dropped them)
+SUMMARY_KEYS = ("steps", "probes", "debonded_area", "first_delamination_load_factor", "restarts", "wall_seconds",
+                "warnings", "path_end", "stabilized", "relaxations")
+
+
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,
             interface_state: dict[str, np.ndarray] | None, summary: dict, rows: list, pvd: dict,
             extra: dict[str, np.ndarray] | None = None) -> Checkpoint:
     """A :class:`Checkpoint` holding copies (later changes of the live state do not reach it)."""
-    keep = {k: summary[k] for k in ("steps", "probes", "debonded_area", "first_delamination_load_factor",
-                                    "restarts", "wall_seconds", "warnings", "path_end") if k in summary}
+    keep = {k: summary[k] for k in SUMMARY_KEYS if k in summary}
     return Checkpoint(int(step), float(load_factor), np.array(u, float, copy=True),
                       np.array(load_factors, float, copy=True), hash_,
                       {k: np.array(v, copy=True) for k, v in (interface_state or {}).items()},

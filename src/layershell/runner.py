@@ -507,10 +507,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
 
     problem.monitor = on_iteration  # called by the Newton loop (solver/newton.py)
 
-    def checkpoint_summary() -> dict:
-        return {k: summary[k] for k in ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end", "stabilized",
-                                        "relaxations")
-                if k in summary}
+    def checkpoint_summary() -> dict:  # the history lives in steps.jsonl, not in the checkpoint
+        return {k: summary[k] for k in checkpoint.SUMMARY_KEYS if k in summary and k not in ("steps", "debonded_area")}
 
     if progress is not None and step0:
         progress(step0, n_steps, lam0)
