@@ -204,3 +204,41 @@ def test_restart_after_a_relaxed_step_repeats_the_uninterrupted_run(tmp_path):
     for k in ("external_work", "dissipated_fracture", "dissipated_viscous", "balance_error"):
         assert b["energy"][k] == pytest.approx(a["energy"][k], rel=1e-8, abs=1e-12), k
     assert b["energy"]["dissipated_viscous"] > 0
+
+
+@pytest.mark.slow
+def test_restart_of_a_stabilised_run_repeats_the_uninterrupted_run(tmp_path):
+    """The force-loaded DCB on 100 elements with ``stabilize = 0.02`` (user guide): stabilised
+    from λ = 0.64 past its peak, it stops at λ = 0.66 where the viscous share of a step exceeds
+    5 %. Interrupted after λ = 0.645 (stabilised) and restarted from its checkpoint, it reaches the
+    same steps, the same 'stabilized' record (where, η, the viscous dissipation) and stops at the
+    same step for the same reason as the uninterrupted run (about 35 s)."""
+    from layershell.runner import run
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text()
+    for a, b in {"nx = 150": "nx = 100", "max_bisections = 6": "max_bisections = 6\nstabilize = 0.02"}.items():
+        assert a in text
+        text = text.replace(a, b)
+    spec = build(parse(text, str(EXAMPLES / "dcb.toml")), EXAMPLES)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    a = full.summary
+    assert not full.converged and "stabilize_limit" in a["error"]
+    lams = [s["load_factor"] for s in a["steps"]]
+    k = lams.index(pytest.approx(0.645))
+    assert a["stabilized"]["load_factor"] == pytest.approx(0.64) and k + 1 < len(lams)
+
+    def stop(i, n, lam):
+        if i == k + 1:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted and part.summary["stabilized"]["load_factor"] == pytest.approx(0.64)
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    b = again.summary
+    assert not again.converged and b["error"] == a["error"] and b["failure"]["step"] == a["failure"]["step"]
+    assert [s["load_factor"] for s in b["steps"]] == pytest.approx(lams, rel=1e-12)
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-9 * abs(full.u).max())
+    for key in ("load_factor", "viscosity"):
+        assert b["stabilized"][key] == pytest.approx(a["stabilized"][key], rel=1e-12)
+    assert b["stabilized"]["dissipated_viscous"] == pytest.approx(a["stabilized"]["dissipated_viscous"], rel=1e-8)
+    assert sum("viscous regularisation was switched on" in w for w in b["warnings"]) == 1  # warned once
