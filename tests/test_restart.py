@@ -336,3 +336,27 @@ def test_checkpoint_round_trip_is_exact(tmp_path):
         assert np.array_equal(back.interface_state[k], v, equal_nan=v.dtype.kind == "f")
         assert back.interface_state[k].dtype == v.dtype
     assert back.summary == ck.summary and back.rows == ck.rows and back.pvd == ck.pvd
+
+
+def test_restart_continues_the_solver_counters(tmp_path):
+    """summary.json counts the whole run across a restart: the linear solver's factorisations
+    and GMRES solves (``reuse_factorization = "always"``) go on from the checkpoint's counts
+    instead of starting again at zero."""
+    model = tmp_path / "tiny.toml"
+    model.write_text(_tiny_text(**{"[steps]\n": '[steps]\nreuse_factorization = "always"\n'}), encoding="utf-8")
+    spec = load(model)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+
+    def stop(i, n, lam):
+        if i == DEBOND_STEP:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    before = part.summary["linear_solves"]
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert full.converged and part.interrupted and again.converged
+    total, ref = again.summary["linear_solves"], full.summary["linear_solves"]
+    assert before["krylov_solves"] > 0 and total["krylov_solves"] > before["krylov_solves"]
+    assert total["factorisations"] > before["factorisations"]
+    # the same run in two parts: about the uninterrupted count (the restart factorises once more)
+    assert abs(total["krylov_solves"] - ref["krylov_solves"]) <= 0.2 * ref["krylov_solves"]

@@ -86,9 +86,10 @@ def _jsonable(obj):
 
 
 #: the summary entries a checkpoint carries to the restarted run (the run's history up to it:
-#: the stabilisation and the relaxed jumps included - a restart once dropped them)
+#: the stabilisation, the relaxed jumps and the solver's counters included - a restart once
+#: dropped them)
 SUMMARY_KEYS = ("steps", "probes", "debonded_area", "first_delamination_load_factor", "restarts", "wall_seconds",
-                "warnings", "path_end", "stabilized", "relaxations")
+                "warnings", "path_end", "stabilized", "relaxations", "active_set", "linear_solves")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,

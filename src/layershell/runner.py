@@ -429,6 +429,10 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         wall0 = float(ck.summary.pop("wall_seconds", 0.0))
         ck.summary.pop("debonded_area", None)
         summary.update(ck.summary)
+        if hasattr(problem, "solve_counts"):  # the counters go on from the checkpoint's (the whole run)
+            problem.accepted_sets = int(summary.get("active_set", {}).get("accepted_within_tolerance", 0))
+            problem.accepted_violation = float(summary.get("active_set", {}).get("largest_violation", 0.0))
+            problem.solve_counts_before = dict(summary.get("linear_solves", {}))
         summary["steps"] = [{k: v for k, v in r.items() if k not in _IN_SUMMARY_ONLY} for r in history]
         if ctl is not None:
             summary["debonded_area"] = [{"step": r["step"], "load_factor": r["load_factor"], **r["debonded_area"]}

@@ -36,6 +36,7 @@ class Problem:
     # strength); reported in summary.json "active_set"
     accepted_sets: int = 0
     accepted_violation: float = 0.0
+    solve_counts_before: dict = field(default_factory=dict, repr=False)  # of the run before a restart
     # the bond flags the constraint operator was built from (rebuild_constraints)
     op_bonded: dict = field(default_factory=dict, repr=False)
 
@@ -78,8 +79,9 @@ class Problem:
         return self.solvers[key]
 
     def solve_counts(self) -> dict:
-        """Factorisations and GMRES solves of this problem's linear solvers (summary.json)."""
-        out: dict = {}
+        """Factorisations and GMRES solves of this problem's linear solvers (summary.json), with
+        those of the run before a restart (``solve_counts_before``)."""
+        out: dict = dict(self.solve_counts_before)
         for sol in self.solvers.values():
             for k, v in sol.counts.as_dict().items():
                 out[k] = out.get(k, 0) + v
