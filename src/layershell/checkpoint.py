@@ -85,11 +85,11 @@ def _jsonable(obj):
     return obj
 
 
-#: the summary entries a checkpoint carries to the restarted run (the run's history up to it:
-#: the stabilisation, the relaxed jumps and the solver's counters included - a restart once
-#: dropped them)
-SUMMARY_KEYS = ("steps", "probes", "debonded_area", "first_delamination_load_factor", "restarts", "wall_seconds",
-                "warnings", "path_end", "stabilized", "relaxations", "active_set", "linear_solves")
+#: the summary entries a checkpoint carries to the restarted run: what the run found up to it
+#: (the stabilisation, the relaxed jumps and the solver's counters included - a restart once
+#: dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
+SUMMARY_KEYS = ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end",
+                "stabilized", "relaxations", "active_set", "linear_solves")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,

@@ -429,9 +429,11 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         wall0 = float(ck.summary.pop("wall_seconds", 0.0))
         ck.summary.pop("debonded_area", None)
         summary.update(ck.summary)
-        if hasattr(problem, "solve_counts"):  # the counters go on from the checkpoint's (the whole run)
+        # the counters go on from the checkpoint's (summary.json counts the whole run)
+        if hasattr(problem, "accepted_sets"):
             problem.accepted_sets = int(summary.get("active_set", {}).get("accepted_within_tolerance", 0))
             problem.accepted_violation = float(summary.get("active_set", {}).get("largest_violation", 0.0))
+        if hasattr(problem, "solve_counts_before"):
             problem.solve_counts_before = dict(summary.get("linear_solves", {}))
         summary["steps"] = [{k: v for k, v in r.items() if k not in _IN_SUMMARY_ONLY} for r in history]
         if ctl is not None:
@@ -511,9 +513,6 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
 
     problem.monitor = on_iteration  # called by the Newton loop (solver/newton.py)
 
-    def checkpoint_summary() -> dict:  # the history lives in steps.jsonl, not in the checkpoint
-        return {k: summary[k] for k in checkpoint.SUMMARY_KEYS if k in summary and k not in ("steps", "debonded_area")}
-
     if progress is not None and step0:
         progress(step0, n_steps, lam0)
     try:
@@ -588,7 +587,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     rcd.step(rec, files)
                     summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
-                                              ctl.state(problem) if ctl is not None else None, checkpoint_summary(),
+                                              ctl.state(problem) if ctl is not None else None, summary,
                                               [], {}, {**_zone_arrays(zones), **_path_arrays(st)})
                     checkpoint.save(rcd.path(checkpoint.FILENAME), last, fsync=rcd.sync_due())
                     rcd.summary(summary)

@@ -496,10 +496,9 @@ class LinearSolver:
         if K.shape[0] == 0:
             return np.zeros(0)
         if self.backend == "pardiso":
-            if self.reuse != "never":
-                x = self._krylov(K, r)
-                if x is not None:
-                    return x  # converged to KRYLOV_RTOL: no singularity check needed
+            x = self._krylov(K, r)  # None without a kept factorisation (always with reuse "never")
+            if x is not None:
+                return x  # converged to KRYLOV_RTOL: no singularity check needed
             sym = self.symmetric and is_symmetric(K)
             if sym not in self._pardiso:
                 cls = PardisoSymmetric if sym else PardisoGeneral
@@ -507,8 +506,7 @@ class LinearSolver:
             x = self._pardiso[sym].solve(K, r)
             self.counts.factorisations += 1
             self.info = self._pardiso[sym].info
-            if self.reuse != "never":
-                self._keep(self._pardiso[sym], K)
+            self._keep(self._pardiso[sym], K)
         else:
             try:
                 lu = spla.splu(sp.csc_matrix(K), permc_spec="COLAMD")

@@ -607,8 +607,8 @@ def relax(problem: Problem, u: np.ndarray, lam_from: float, lam: float, s: Newto
     rate-independent damage d everywhere. Then the law is switched back and the state must be an
     equilibrium of the rate-independent law: a Newton solve at ``lam`` that converges there with
     its damage within RELAX_LAG of the relaxed one ends the relaxation (else it relaxes on). This
-    is the dynamic snap of a displacement-controlled test at a snap-back (or the collapse of a force-controlled one past a limit point) without
-    inertia: the energy the jump releases is dissipated by the viscous law, booked as
+    is the dynamic snap of a displacement-controlled test at a snap-back (or the collapse of a
+    force-controlled one past a limit point) without inertia: the energy the jump releases is dissipated by the viscous law, booked as
     ``dissipated_viscous`` in the energy ledger, and recorded per event
     (``InterfaceController.relaxations``: load factors, increments, the released energy, the
     debonded fraction before and after). None: nothing to relax (the setting is off, or no
