@@ -9,6 +9,7 @@ tests/test_dcb.py (``displacement_controlled``).
     PYTHONPATH=src python benchmarks/dcb.py 100 --relax    # unstable jumps relaxed ([steps] unstable)
     PYTHONPATH=src python benchmarks/dcb.py 200 --relax --element mitc   # the MITC9 element
     PYTHONPATH=src python benchmarks/dcb.py --arc 100 [600]  # force-loaded, arc length (max steps)
+    PYTHONPATH=src python benchmarks/dcb.py --arc 200 2000 --target 16  # [steps] target_iterations = 16
 
 Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
 the load at the opening δ = 8 mm (interpolated along the branch), the branch's range against
@@ -91,18 +92,20 @@ def order(h: list[float], f: list[float]) -> float:
     return p
 
 
-def arc_length(nx: int, max_steps: int) -> dict:
+def arc_length(nx: int, max_steps: int, target: int | None = None) -> dict:
     """The force-loaded DCB (the example's edge loads) traced by arc length with the dissipation
     constraint, from the start through the peak and the propagation branch, at most
     ``max_steps`` increments: steps, Newton iterations (all attempts), the iterations of the
     attempts that failed and were cut (the step's total minus the accepted attempt's cannot be
     separated from summary.json, so the count of cut increments is printed), CPU and wall time,
-    the peak and the last load and why the path ended."""
+    the peak and the last load and why the path ended. ``target``: ``[steps] target_iterations``
+    (the step-size control's iterations per increment; None: the default, 8)."""
     from helpers import run_example
 
     t0, c0 = time.perf_counter(), time.process_time()
+    extra = f"target_iterations = {target}\n" if target is not None else ""
     r = run_example("dcb_cohesive", {"nx = 150": f"nx = {nx}",
-                                     "factors = [0.01, 0.02, 0.05,": f'control = "arc_length"\nn = 50\nmax_steps = {max_steps}\n#'})
+                                     "factors = [0.01, 0.02, 0.05,": f'control = "arc_length"\nn = 50\nmax_steps = {max_steps}\n{extra}#'})
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     st = r.summary["steps"]
     P = np.array([s["probes"]["P"] for s in st])
@@ -114,12 +117,17 @@ def arc_length(nx: int, max_steps: int) -> dict:
 
 
 def main(argv: list[str]) -> None:
-    if "--arc" in argv:  # python benchmarks/dcb.py --arc 100 [max_steps]
+    if "--arc" in argv:  # python benchmarks/dcb.py --arc 100 [max_steps] [--target N]
+        target = None
+        if "--target" in argv:
+            i = argv.index("--target")
+            target = int(argv[i + 1])
+            argv = argv[:i] + argv[i + 2:]
         i = argv.index("--arc")
         nx = int(argv[i + 1])
         max_steps = int(argv[i + 2]) if len(argv) > i + 2 else 600
         os.environ.setdefault("LAYERSHELL_THREADS", "1")
-        m = arc_length(nx, max_steps)
+        m = arc_length(nx, max_steps, target)
         print("| elements | steps | iterations | increments cut | CPU (s) | wall (s) | P_max (N) | last P (N) | "
               "last opening (mm) | energy balance | end |")
         print("|---|---|---|---|---|---|---|---|---|---|---|")

@@ -256,6 +256,79 @@ def test_set_violation_is_the_traction_change_of_the_actual_sets():
     blk.unfreeze()
 
 
+def test_frozen_opening_point_jumps_at_closure_and_is_released():
+    """Within frozen sets an opening, loading point keeps the softening line t = K λ0 (λf - λ)/
+    (λf - λ0) along δ/|δ|: its normal traction reverses across δ_n = 0, from +K λ0 (λf - ε)/
+    (λf - λ0) at δ_n = ε to the negative at -ε (ε = λ0/100 here; the bilinear law's parameters
+    computed here), within a band of about 10⁻³ λ0 where the continuation's damage is bounded
+    at -10³ - practically a jump, which Newton iterates crossing it cannot pass (the
+    force-loaded DCB's failed arc-length increments). Closed (out of both sets) the point's
+    traction K δ_n is continuous and monotone there. ``release_closed`` takes exactly the
+    opening, loading points that an iterate closes out of both sets and leaves every other
+    point as it was."""
+    from layershell.cohesive import onset, point_response
+
+    pb, blk, ur = _damaged_problem("lobatto")
+    K, law = blk.K, blk.law
+    n = np.array([[0.0, 0.0, 1.0]])
+    d_old = np.array([0.3])
+    l0 = float(onset(np.zeros(1), K, law)[0][0])
+    lf = 2.0 * law.G_Ic / (K * l0)
+    eps = 0.01 * l0
+    jump = 2.0 * K * l0 * (lf - eps) / (lf - l0)
+    frozen_open = (np.array([True]), np.array([True]))
+    tp, _, _ = point_response(np.array([[0.0, 0.0, eps]]), n, d_old, K, law, tangent=False, frozen=frozen_open)
+    tm, _, _ = point_response(np.array([[0.0, 0.0, -eps]]), n, d_old, K, law, tangent=False, frozen=frozen_open)
+    assert tp[0, 2] - tm[0, 2] == pytest.approx(jump, rel=1e-6)
+    closed = (np.array([False]), np.array([False]))
+    tp, _, _ = point_response(np.array([[0.0, 0.0, eps]]), n, d_old, K, law, tangent=False, frozen=closed)
+    tm, _, _ = point_response(np.array([[0.0, 0.0, -eps]]), n, d_old, K, law, tangent=False, frozen=closed)
+    assert tp[0, 2] - tm[0, 2] == pytest.approx(2.0 * K * eps, rel=1e-9)
+
+    u0 = pb.op.T @ ur
+    blk.freeze(u0)
+    tension, loading = (a.copy() for a in blk.frozen)
+    assert blk.release_closed(u0) == 0  # nothing frozen opening is closed at the freezing state
+    assert all(np.array_equal(a, b) for a, b in zip(blk.frozen, (tension, loading)))
+    u1 = -u0  # every separation reversed: the opening points close
+    crossed = tension & loading & (blk.gap(u1) < 0)
+    assert crossed.sum() >= 2
+    assert blk.release_closed(u1) == crossed.sum()
+    assert np.array_equal(blk.frozen[0], tension & ~crossed) and np.array_equal(blk.frozen[1], loading & ~crossed)
+    assert blk.release_closed(u1) == 0  # done: the closed points stay closed within the solve
+    blk.unfreeze()
+    assert blk.release_closed(u1) == 0  # nothing frozen
+
+
+def test_partial_symmetry_check_equals_the_full_pass():
+    """A linear model's K_r differs from the layers' constant tangent only where the cohesive
+    block writes, so the solver's symmetry check reads only the pairs there
+    (assembly._PartialSymmetry); its (largest mirror difference, largest entry) equal the full
+    pass over every entry - in an undamaged state and with growing mixed-mode damage, where K_r
+    is not symmetric - and so does the solver's decision."""
+    from layershell import _assembly_jit as J
+    from layershell.solver.linear import is_symmetric
+
+    spec = strip(nonlinear="false", nx=2, cohesive={"smax": 1.0, "tmax": 2.0})
+    pb = Problem.build(spec.model)
+    blk = pb.extra_blocks[0]
+    rng = np.random.default_rng(5)
+    ur = rng.normal(size=pb.op.n_red)
+    lam = np.linalg.norm(blk.separation(pb.op.T @ ur), axis=-1)
+    decisions = []
+    for scale, d_old in ((1e-3, 0.0), (3.0, 0.2)):  # elastic; softening and unloading points
+        blk.d_old = np.full(blk.d_old.shape, d_old)
+        u = pb.op.T @ (ur * scale / (blk.K * np.median(lam)))
+        _, K = pb.assembler.evaluate_reduced(u, pb.op)
+        assert K.partial_symmetry is not None and K.partial_symmetry.upper.size < K.scatter.upper_pos.size
+        rs = K.scatter
+        full = J.mirror_difference_and_max(K.data, rs.upper_pos, rs.mirror_pos)
+        assert K.symmetry_check() == (float(full[0]), float(full[1]))
+        decisions.append(is_symmetric(K))
+        assert is_symmetric(K) == (full[0] <= 1e-12 * full[1])
+    assert decisions == [True, False]
+
+
 def test_active_set_loop_accepts_a_cycling_state_only_within_the_tolerance():
     """ActiveSetLoop: a converged state with sets violated by less than the tolerance is
     accepted (and counted) when the loop fails; one violated by more is not."""

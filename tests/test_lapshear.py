@@ -55,10 +55,11 @@ JOINT = BondedJoint(E_p=E_P, t_p=T_P, b_p=B_P, tau_f=TAU_F, delta_1=TAU_F / ITF[
 P_U = B_P * np.sqrt(2 * G_F * E_P * T_P)
 
 
-def model_text(L: float, h: float = 10.0, extra: dict[str, str] | None = None) -> str:
+def model_text(L: float, h: float = 10.0, extra: dict[str, str] | None = None, arc_fraction: float = 1.0) -> str:
     """The example with bond length ``L`` and elements of length ``h`` along it; the largest arc
-    length scales with the square root of the number of nodes (the same slip increments)."""
-    cap = 0.05 * np.sqrt((L / h) / NX0)
+    length scales with the square root of the number of nodes (the same slip increments), times
+    ``arc_fraction``."""
+    cap = 0.05 * np.sqrt((L / h) / NX0) * arc_fraction
     text = (TEXT.replace(f"lx = {L0}", f"lx = {L}").replace(f"nx = {NX0}", f"nx = {int(round(L / h))}")
             .replace(f"arc_length_max = {STEPS['arc_length_max']}", f"arc_length_max = {cap:.6g}"))
     for a, b in (extra or {}).items():
@@ -77,12 +78,13 @@ def interface_state(pb, u) -> tuple[float, float, float]:
     return float(T[..., 2].max()), float(T[..., 2].min()), float(B[soft].min()) if soft.any() else 1.0
 
 
-def trace(L: float = L0, h: float = 10.0, until: str = "peak", extra: dict[str, str] | None = None) -> dict:
+def trace(L: float = L0, h: float = 10.0, until: str = "peak", extra: dict[str, str] | None = None,
+          arc_fraction: float = 1.0) -> dict:
     """The path of the example (arc length, dissipation control) with bond length ``L``: load P,
     loaded-end slip, free-end slip, the energy ledger and :func:`interface_state` at every
     converged step. ``until``: "peak" stops once the load has fallen 3 % below its maximum,
     "end" when it is below 1 % of P_u (complete debonding; the last percent creeps to zero)."""
-    spec = build(parse(model_text(L, h, extra), "lapshear"), EXAMPLES)
+    spec = build(parse(model_text(L, h, extra, arc_fraction), "lapshear"), EXAMPLES)
     pb = Problem.build(spec.model)
     ctl = pb.interfaces
     probes = {p.name: p for p in spec.probes}
@@ -303,12 +305,16 @@ def test_pull_push_with_a_deformable_substrate():
 @pytest.mark.slow
 def test_peak_converges_with_the_mesh():
     """Peak of the L = 100 mm bond (below L_e, where the peak is sharpest) on elements of 20, 10,
-    5 and 2.5 mm: the differences between successive meshes fall by a factor of about 6 and 8
-    (measured -0.100, -0.053, -0.061, -0.062 % against the closed form: differences 0.047,
-    0.008, 0.001 %, a rate of about 2.5-3 in h) towards -0.06 % (the eccentricity)."""
-    P = [trace(100.0, h)["peak"] for h in (20.0, 10.0, 5.0, 2.5)]
+    5 and 2.5 mm, with a quarter of the example's largest arc length so that the parabola of
+    :func:`peak` resolves it: measured +0.093, -0.075, -0.067, -0.063 % against the closed form
+    (differences 0.17, 0.008, 0.004 %). Below about 0.01 % the traced peak depends on where the
+    increments fall (the crack advances node by node; a sixteenth of the arc length gives
+    +0.103, -0.076, -0.060, -0.064 %), so the finer differences are only bounded by that; with
+    the example's own arc length the 20 mm mesh's peak reads -0.098 %: not resolved."""
+    P = [trace(100.0, h, arc_fraction=0.25)["peak"] for h in (20.0, 10.0, 5.0, 2.5)]
     d = np.abs(np.diff(P))
-    assert d[1] < 0.5 * d[0] and d[2] < 0.5 * d[1]
+    assert d[0] > 5.0 * max(d[1], d[2])
+    assert max(d[1], d[2]) < 1e-4 * P[-1]
     assert all(p == pytest.approx(JOINT.peak_load(100.0), rel=0.003) for p in P)
 
 

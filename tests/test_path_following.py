@@ -364,6 +364,25 @@ def test_adaptive_steps_reach_the_end_in_fewer_steps():
     assert res["adaptive"][2] == pytest.approx(res["fixed"][2], rel=1e-9)
 
 
+def test_target_iterations_sets_the_step_size_control():
+    """``[steps] target_iterations`` reaches the step-size control: the adaptive cantilever with
+    a target of 16 iterations per step takes fewer, longer steps than with the default 8, to the
+    same answer; 0 is bad input naming the field."""
+    from layershell.io.build import InputError
+
+    res = {}
+    for target in (8, 16):
+        spec = _spec(FORCE_TIP.format(P=0.5), True, 20, f"adaptive = true\ntarget_iterations = {target}")
+        assert spec.path_following.target_iterations == target
+        r = run(spec)
+        assert r.converged and r.summary["steps"][-1]["load_factor"] == 1.0
+        res[target] = (len(r.summary["steps"]), r.summary["probes"]["w"])
+    assert res[16][0] < res[8][0]
+    assert res[16][1] == pytest.approx(res[8][1], rel=1e-9)
+    with pytest.raises(InputError, match="target_iterations"):
+        _spec(FORCE_TIP.format(P=0.5), True, 20, "adaptive = true\ntarget_iterations = 0")
+
+
 def test_jump_warnings_unit():
     from layershell.solver.arclength import jump_warnings
 

@@ -417,6 +417,34 @@ class CohesiveBlock:
                 loading = np.where(viol >= (1.0 - 1e-6) * worst, loading, prev)
         self.frozen = (tension, loading)
 
+    def release_closed(self, u_full: np.ndarray) -> int:
+        """Take the points frozen as opening and loading whose normal separation is negative at
+        ``u_full`` out of both sets (closed, damage held); returns how many.
+
+        Within the frozen sets the traction of such a point is K (1 - d(λ)) δ with λ = |δ|
+        and d on the softening line, t = K λ0 (λf - λ)/(λf - λ0) δ/λ: a jump of about twice the
+        strength where δ passes through zero (in mode I at δ_n = 0). A Newton iterate that
+        pushes the point just behind a crack front across it - the first correction of an
+        increment often does, the point opening only by about λ0 - is then thrown back, and
+        the iterates alternate between the two sides for good (the force-loaded DCB on 200
+        elements, arc length: 122 of 418 increments failed so, their residual frozen at one
+        point's jump). Closed, the point's law is continuous there (K δ_n across δ_n = 0), so
+        the frozen problem is continuous again; where the point opens at the solution after
+        all, the set check finds it (:meth:`set_violation`) and the active-set loop freezes it
+        opening again. Only this direction changes, so the release cannot cycle within one
+        solve."""
+        if self.frozen is None or self.frozen[1] is None:
+            return 0
+        tension, loading = self.frozen
+        if not np.any(tension & loading):
+            return 0
+        g = self.gap(u_full)
+        crossed = tension & loading & (g < 0.0)
+        n = int(crossed.sum())
+        if n:
+            self.frozen = (tension & ~crossed, loading & ~crossed)
+        return n
+
     def set_changed(self, u_full: np.ndarray) -> bool:
         """Do the frozen sets still hold at the converged ``u_full``? Tension: where it matters
         (damaged points). Loading: a loading point whose damage fell below its history, or a

@@ -57,7 +57,8 @@ def _path_settings(st: schema.Steps, model: Model):
     return PathSettings(control=st.control, lambda_end=st.lambda_end, increment=inc,
                         increment_max=st.increment_max, arc_length=st.arc_length, arc_length_min=st.arc_length_min,
                         arc_length_max=st.arc_length_max, dissipation=st.dissipation,
-                        dissipation_threshold=st.dissipation_threshold, max_steps=st.max_steps,
+                        dissipation_threshold=st.dissipation_threshold, target_iterations=st.target_iterations,
+                        max_steps=st.max_steps,
                         max_cuts=max(st.max_bisections, 1), jump_area=st.jump_area, jump_ratio=st.jump_ratio)
 
 

@@ -389,7 +389,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             res.best = best[1]
             return u, res
         # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
-        _, Kr = asm.evaluate_reduced(u, op)
+        _, Kr = asm.evaluate_reduced(u, op, forces=False)
         try:
             du = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, r)
         except linear.SingularSystemError as exc:
@@ -413,6 +413,15 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     res.message = f"no convergence in {s.max_iterations} iterations (last residual {res.residuals[-1]:.3e})"
     res.best = best[1]
     return u, res
+
+
+def release_closed(asm, u: np.ndarray) -> None:
+    """Before the forces at a new iterate: frozen cohesive points that it closes leave the
+    opening and loading sets (:meth:`~layershell.cohesive.CohesiveBlock.release_closed`: the
+    frozen law jumps there)."""
+    for b in asm.extra:
+        if getattr(b, "frozen", None) is not None and hasattr(b, "release_closed"):
+            b.release_closed(u)
 
 
 def at_round_off_floor(residuals: list[float], scale: float, en: float, e0: float, dU: np.ndarray, u: np.ndarray,
