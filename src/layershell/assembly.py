@@ -292,7 +292,7 @@ class _PartialSymmetry:
     evaluate_reduced`): the pairs (entry, mirror) of which neither is such an entry keep the
     base's values, so their largest mirror difference and entry are taken once; an evaluation
     reads only the pairs that touch ``rows`` (the DCB on 200 elements: 0.6 M of 4.2 M
-    entries). The result equals the full pass's (tests/test_assembly.py)."""
+    entries). The result equals the full pass's (tests/test_cohesive_interface.py)."""
 
     upper: np.ndarray  # the pairs that touch a changing entry: upper positions ...
     mirror: np.ndarray  # ... and their mirrors
@@ -514,11 +514,12 @@ class Assembler:
     def _values(self, u_full: np.ndarray, tangent: bool, compact: bool = False, forces: bool = True):
         """Full-space internal force and (when ``tangent``) the summed CSR data of K; with
         ``compact`` on a linear model (:meth:`_linear_bulk`) the data of the extra blocks alone at
-        the bulk's ``touched`` positions (and, without ``forces``, no layer forces in f)."""
+        the bulk's ``touched`` positions; without ``forces`` (a linear model's tangent) f holds the extra
+        blocks' forces only."""
         n = self.dm.n_full
         bulk = self._linear_bulk() if tangent else None
         if bulk is not None:
-            f = self._layer_forces(u_full) if forces or not compact else np.zeros(n)
+            f = self._layer_forces(u_full) if forces else np.zeros(n)
             extra = np.zeros(bulk.touched.size)
             self._extra_values(u_full, True, f, extra, bulk.compact, 0)
             if compact:
@@ -568,11 +569,9 @@ class Assembler:
         f, extra = self._values(u_full, True, compact=True, forces=forces)
         _, base, rows, Pt, partial = bulk.reduced
         data, filled = bulk.buffer(base.size)
-        if filled is base:  # base values everywhere but at rows (nothing writes a lent K_r's data)
-            data[rows] = base[rows] + Pt @ extra
-        else:  # a new array, or one of another operator
-            np.copyto(data, base)
-            data[rows] += Pt @ extra
+        if filled is not base:  # a new array, or one of another operator; else it holds the base
+            np.copyto(data, base)  # everywhere but at rows (nothing writes a lent K_r's data)
+        data[rows] = base[rows] + Pt @ extra
         K = rs.matrix_from_values(data, symmetric=self.symmetric)
         K.partial_symmetry = partial
         bulk.lend(data, K, base)

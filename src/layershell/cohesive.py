@@ -422,12 +422,13 @@ class CohesiveBlock:
         ``u_full`` out of both sets (closed, damage held); returns how many.
 
         Within the frozen sets the traction of such a point is K (1 - d(λ)) δ with λ = |δ|
-        and d on the softening line, t = K λ0 (λf - λ)/(λf - λ0) δ/λ: a jump of about twice the
-        strength where δ passes through zero (in mode I at δ_n = 0). A Newton iterate that
+        and d on the softening line, t = K λ0 (λf - λ)/(λf - λ0) δ/λ: it reverses where δ
+        passes through zero (in mode I at δ_n = 0), within about 10⁻³ λ0 where the continued
+        damage is bounded at -10³ - practically a jump of twice the strength. A Newton iterate that
         pushes the point just behind a crack front across it - the first correction of an
         increment often does, the point opening only by about λ0 - is then thrown back, and
         the iterates alternate between the two sides for good (the force-loaded DCB on 200
-        elements, arc length: 122 of 418 increments failed so, their residual frozen at one
+        elements, arc length: 122 of 418 attempts failed so, their residual frozen at one
         point's jump). Closed, the point's law is continuous there (K δ_n across δ_n = 0), so
         the frozen problem is continuous again; where the point opens at the solution after
         all, the set check finds it (:meth:`set_violation`) and the active-set loop freezes it

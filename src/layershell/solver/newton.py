@@ -415,17 +415,6 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     return u, res
 
 
-def release_closed(asm, u: np.ndarray) -> None:
-    """Before the forces at a new iterate: frozen cohesive points that it closes leave the
-    opening and loading sets (:meth:`~layershell.cohesive.CohesiveBlock.release_closed`: the
-    frozen law jumps there). Used by the arc-length iterations (solver/arclength.py); in the
-    load-controlled loop of :func:`newton` it made the displacement-controlled DCB stop earlier
-    (δ = 4.2 instead of 10 mm on 150 elements, its loop cycling), so it is not used there."""
-    for b in asm.extra:
-        if getattr(b, "frozen", None) is not None and hasattr(b, "release_closed"):
-            b.release_closed(u)
-
-
 def at_round_off_floor(residuals: list[float], scale: float, en: float, e0: float, dU: np.ndarray, u: np.ndarray,
                        s: NewtonSettings, work: Callable[[], float]) -> bool:
     """The round-off floor test of the Newton iterations (module docstring): the last of the
