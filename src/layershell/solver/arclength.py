@@ -133,11 +133,53 @@ def check_path(problem: Problem, ps: PathSettings) -> None:
                         "for displacement control, or set scaled = false on that support")
 
 
-def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float) -> float:
+def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float,
+                          f_itf0: np.ndarray | None = None) -> float:
     """ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀): energy dissipated by secant-unloading damage in the increment
-    (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20))."""
+    (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20)). With ``f_itf0`` (the interface
+    forces at u₀, :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀) instead."""
+    if f_itf0 is not None:
+        f1, _ = interface_forces(problem, u0 + du)
+        return 0.5 * (float(f_itf0 @ (u0 + du)) - float(f1 @ u0))
     F = problem.F_scaled
     return 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
+
+
+def interface_form(problem: Problem) -> bool:
+    """Is the dissipation of an increment measured at the interfaces? On a geometrically nonlinear
+    model with cohesive interfaces. Gutiérrez's ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀) takes the stored energy
+    to be ½ λ F̂ᵀu, true of a linear bulk only: on a nonlinear one an elastic increment 'dissipates'
+    (the §5.1 plate with MITC9 on 6 × 6: the dissipation-controlled increments shrank to 10⁻⁷ of
+    the first at λ = 0.895 and the path never reached λ = 1; with ``nonlinear = false`` it does).
+    The energy the interfaces take, less what they store, does not involve the bulk:
+
+        ΔG = ½(f_I(u₀) + f_I(u))·Δu − (ψ_I(u) − ψ_I(u₀)) = ½(f_I(u₀)·u − f_I(u)·u₀)
+
+    (trapezoidal work of the interface forces f_I; ψ_I = ½ f_I·u for the secant law of
+    :mod:`layershell.cohesive` and penalty contact, the separation linear in u). On a linear
+    bulk at equilibrium (f_I = λF̂ − K_L u, K_L symmetric) it equals Gutiérrez's form exactly,
+    which is kept there (linear in the unknowns)."""
+    if not problem.model.nonlinear:
+        return False
+    from ..cohesive import CohesiveBlock
+
+    return any(isinstance(b, CohesiveBlock) for b in problem.assembler.extra)
+
+
+def interface_forces(problem: Problem, u: np.ndarray, v: np.ndarray | None = None
+                     ) -> tuple[np.ndarray, np.ndarray | None]:
+    """The interface blocks' internal force f_I(u) (full space) and, given ``v``, K_I(u)ᵀ v
+    (their tangent at u, in its current frozen state, transposed, applied to v)."""
+    n = problem.dm.n_full
+    f = np.zeros(n)
+    kv = None if v is None else np.zeros(n)
+    for b in problem.assembler.extra:
+        fe, Ke = b.response(u, tangent=v is not None)
+        dofs = b.dofs
+        f += np.bincount(dofs.ravel(), weights=np.asarray(fe).ravel(), minlength=n)
+        if v is not None:
+            kv += np.bincount(dofs.ravel(), weights=np.einsum("eij,ei->ej", Ke, v[dofs]).ravel(), minlength=n)
+    return f, kv
 
 
 def _frozen_blocks(problem: Problem) -> list:
@@ -152,7 +194,8 @@ def _frozen_blocks(problem: Problem) -> list:
 
 
 def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode: str,
-                du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float) -> Attempt:
+                du_prev: np.ndarray | None, s: NewtonSettings, ps: PathSettings, lam_ref: float,
+                f_itf0: np.ndarray | None = None) -> Attempt:
     """One increment from the equilibrium (u0, λ0) under the arc-length (``mode = "arc"``, Δl =
     ``size``) or the dissipation constraint (``"dissipation"``, Δτ = ``size``).
 
@@ -164,7 +207,9 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     759 instead of 923 iterations), the constrained Newton iterations converge on the then
     smooth problem, the sets are checked at the solution and, where they changed, frozen there
     and the same increment iterated on, at most ``max_active_set_loops`` times. A frozen opening
-    point that an iterate closes leaves the sets (:func:`_release_closed`)."""
+    point that an iterate closes leaves the sets (:func:`_release_closed`). ``f_itf0``: the
+    interface forces at u0 where the dissipation is measured at the interfaces
+    (:func:`interface_form`)."""
     op, asm = problem.op, problem.assembler
     blocks = _frozen_blocks(problem)
     loop = ActiveSetLoop(blocks, True)
@@ -186,6 +231,13 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         wf = full_weights(problem)
         if (float((du_prev * wf) @ (dUt * wf)) if du_prev is not None else float(q @ dut)) < 0.0:
             dlam = -dlam
+    elif f_itf0 is not None:  # interface form (interface_form): ΔG ≈ ½(f_I(u₀) − K_Iᵀu₀)·Δu
+        _, kv = interface_forces(problem, u0, u0)
+        a1, a2 = 0.5 * float(f_itf0 @ dUt), 0.5 * float(kv @ dUt)
+        if abs(a1 - a2) <= 1e-6 * (abs(a1) + abs(a2)):
+            att.message = "no dissipation in the predictor direction"
+            return _unfrozen(att, blocks)
+        dlam = size / (a1 - a2)
     else:
         F = problem.F_scaled
         den = 0.5 * (lam0 * float(F @ dUt) - float(F @ u0))
@@ -203,7 +255,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
-                                                s.stagnation_iterations if blocks else 0)
+                                                s.stagnation_iterations if blocks else 0, f_itf0)
         if not ok:
             return _unfrozen(att, blocks, loop, problem)
         if loop.consistent(att.u, (att.u, att.lam)):
@@ -229,7 +281,8 @@ def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, pro
 
 def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
-                            max_iterations: int, stagnation: int = 0) -> tuple[np.ndarray, float, bool]:
+                            max_iterations: int, stagnation: int = 0,
+                            f_itf0: np.ndarray | None = None) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
     it converged. ``stagnation``: give up after that many iterations in a row without progress
@@ -295,6 +348,17 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
                 roots = [(-B + sq) / (2.0 * A), (-B - sq) / (2.0 * A)]
             # the root whose increment keeps the direction of the current one
             dl = max(roots, key=lambda x: float((w + x * bw) @ dw) + ps.psi**2 * qq * (dlam + x) * dlam)
+        elif f_itf0 is not None:
+            # interface form (interface_form): g = ½(f_I(u₀)·u − f_I(u)·u₀) − Δτ, linearised with
+            # ∂g/∂u = ½(f_I(u₀) − K_I(u)ᵀu₀): g + c·(A + δλ B) = 0 for δu = A + δλ B
+            fI, kv = interface_forces(problem, u, u0)
+            g = 0.5 * (float(f_itf0 @ u) - float(fI @ u0)) - size
+            c = 0.5 * (f_itf0 - kv)
+            cA, cB = float(c @ op.expand(a)), float(c @ op.expand(b))
+            if cB == 0.0:
+                att.message = "the dissipation constraint does not depend on λ here"
+                return dur, dlam, False
+            dl = -(g + cA) / cB
         else:
             # ½ F̂ᵀ(λ₀ (Δu + a + δλ b) − (Δλ + δλ) u₀) = Δτ  (linear in δλ)
             F = problem.F_scaled
@@ -409,6 +473,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     scales = probe_scales({}, probes_prev)
     end = ps.lambda_end
     recent: list[float] = []  # λ of the last accepted increments (stalled())
+    itf_form = interface_form(problem)  # the dissipation measured at the interfaces
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
@@ -417,6 +482,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         allow_jump = tried_dissipation = False
         warns: list[str] = []
         size0 = st.size
+        f_itf0 = interface_forces(problem, u)[0] if itf_form else None  # the start's (committed) state
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
@@ -428,7 +494,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
             else:
                 att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
-                                  max(st.lam_peak, abs(lam)))
+                                  max(st.lam_peak, abs(lam)), f_itf0)
                 if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
                     u_new, res = newton(problem, u, end, s)
                     if res.converged:
@@ -455,7 +521,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
                     else:  # the same increment again under the same constraint in the new state
                         att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,
-                                          max(st.lam_peak, abs(lam)))  # sign: the work criterion in the new state
+                                          max(st.lam_peak, abs(lam)), f_itf0)  # sign: the work criterion in the new state
                     total_it += att.iterations
                     residuals += att.residuals
                     if not att.converged:
@@ -531,7 +597,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # accepted increment
         du = att.u - u
         dlam = att.lam - lam
-        dG = dissipation_increment(problem, u, lam, du, dlam)
+        dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0)
         st.dissipated += dG
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
