@@ -45,15 +45,18 @@ def _edges(m, mask):
 @pytest.mark.parametrize("nonlinear", [False])
 @pytest.mark.parametrize("element", ["mitc", "full"])
 def test_membrane_patch_constant_stress(rng, d, nonlinear, element):
-    """Uniaxial traction σ on the x = lx edge of a distorted mesh: the stress is σ at every
-    point (exact), the other components vanish, and u_x = σ x / E.
+    """Uniaxial traction σ on the x = lx edge of a distorted mesh with curved element edges
+    (inner nodes moved at random): the stress is σ at every point (exact), the other components
+    vanish, and u_x = σ x / E.
 
-    The fully integrated element is exact on curved-edged distorted elements too; the MITC9
-    element (strains tied in the rotated centre frame) on straight-edged distorted elements, as
-    MITC9 elements in general (with curved edges the tied B̃ no longer integrates to the B of
-    a constant stress: 0.26 % error of u_x on this mesh; the natural-frame MITC9 of Bucalem &
-    Bathe misses even straight-edged distortion, 3e-5, see tests/test_mitc.py)."""
-    m = _distorted_plate(rng, straight=element == "mitc")
+    Both elements are exact. The MITC9 element needs two things for it: strains tied in the
+    rotated centre frame (constant on a flat element; the natural-frame MITC9 of Bucalem & Bathe
+    misses even straight-edged distortion, 3e-5, tests/test_mitc.py) and the consistency
+    correction of its tying (mitc.tie_correction): without it the tied B̃ no longer integrates to
+    the B of a constant stress once the edges are curved (0.3 % error of u_x on this mesh,
+    exact on straight-edged distortion; tests/test_mitc.py
+    test_consistency_correction_gives_the_constant_stress_nodal_forces)."""
+    m = _distorted_plate(rng)
     E, nu, H, sig = 1000.0, 0.3, 0.1, 2.0
     x = m.nodes
     ly = Layer("p", Orthotropic.isotropic(E, nu), d, np.full(m.n_nodes, H))

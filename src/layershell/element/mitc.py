@@ -28,11 +28,41 @@ element (``kernel.py``) is the special case "every component sampled at the Gaus
 :func:`tying` with ``full=True`` gives it (test).
 
 The components are taken in a frame F_b (:func:`strain_frames`): by default the centre frame
-transported to each point (so that the membrane patch test is exact on straight-edged distorted
-elements), or the natural convected basis G_i of the original MITC9 (``frame="natural"``); the
-formulas above hold with G_i → F_b and ∂_i → the derivative along F_b. At least d + 1 thickness
-points are used. :func:`tied_strain` gives the same tied strain at any point (probes, profiles,
-delamination criterion via ``results.evaluate_points``).
+transported to each point (constant on a flat element, so that a constant strain is tied
+exactly on a distorted element), or the natural convected basis G_i of the original MITC9
+(``frame="natural"``); the formulas above hold with G_i → F_b and ∂_i → the derivative along
+F_b. At least d + 1 thickness points are used. :func:`tied_strain` gives the same tied strain at
+any point (probes, profiles, delamination criterion via ``results.evaluate_points``).
+
+Consistency correction (:func:`tie_correction`, on by default). A constant tied strain is not
+enough for the membrane patch test: equilibrium with the consistent nodal forces of a constant
+stress needs Σ_q dV_q B̃_q = ∫ B dV. The tied rows give tie t of component c the weight
+W_t = Σ_q dV_q h_t(q), while ∫ B dV is integrated exactly by the product Gauss rule of the tying
+points themselves (2 × 3, 3 × 2, 2 × 2) with the weights w̄_t = w_t ρ(p_t), ρ = detG H/2: on a
+flat element ρ times an in-plane row is a polynomial of degree 3 in each natural coordinate. The
+two agree where ρ is bilinear (straight edges), not with curved edges (0.3 % error of the
+membrane patch test of tests/test_patch.py without the correction). Each tie strain of component
+c is therefore replaced by E'_t = E_t + v_cᵀ E_c, v_t = (w̄_t − W_t)/V with w̄ scaled to
+Σ_t w̄_t = V (so Σ_t v_t = 0, V = Σ_q dV_q): since the tying functions reproduce constants, this
+is the same shift at every Gauss point, Ẽ' = Ẽ + (Σ_t w̄_t E_t − Σ_q dV_q Ẽ_q)/V, the mean of
+the tied field moved to the tying-point quadrature of the strain (a mean correction like the
+B-bar method's, Hughes 1980, towards a rule the MITC sampling points already carry). Then
+Σ_q dV_q B̃'_q = Σ_t w̄_t B_t = ∫ B dV for the in-plane rows and the membrane patch test is exact
+on curved-edged elements. Not covered, before or after: a constant transverse shear σ_α3 on
+curved edges (the rows of E_α3 hold N_n itself, and ρ N_n has degree 5 in the two-point
+direction; about 1 % of the nodal forces on a curved-edged element), and the bending patch
+with curved edges, whose quadratic displacement the isoparametric space does not contain (the
+full element misses it too). In the tie space the correction is the invertible map P = I + U Vᵀ
+(U the component indicator, det P = 1): the kernel is unchanged, Ĉ → Pᵀ Ĉ P once per block
+(:func:`tied_stiffness`). It keeps the element free of locking: Ẽ' = H P E vanishes exactly
+where Ẽ = H E does (P invertible), so the displacements free of tied shear and membrane strain
+— the thin-limit constraint set — are the plain MITC9's, and the zero-energy modes are the
+same; v = 0 on straight-edged flat elements and to round-off on the regular cylinder meshes of
+examples/shell_benchmarks.py (Scordelis-Lo and the pinched cylinder unchanged to 1e-10, distorted
+thin plates and roofs to 1e-3 of the deflection). For comparison: the corrected shape functions
+of Celia & Gray (1984) in MITC9i (Wisniewski & Turska 2018, Comput. Mech. 62) make the 9-node
+shell pass the patch tests for mid-side nodes moved along straight sides and any centre node,
+not for curved sides.
 """
 from __future__ import annotations
 
@@ -73,6 +103,9 @@ class Tying:
     shear, decoupled from the others where the material's third axis is the normal)
     gn (P, 3), gk, gJ (P, 3, 3) int: for the r-th direction K = dirs[p, r], the gn ties k and the
     directions J with σ_JK(p) = σ_k (the geometric term's stress rows)
+    rule (6, T): weight of tie t of component c in the product Gauss rule its tying points form
+    (2 × 3, 3 × 2, 2 × 2; the 3 × 3 rule where a component is taken at the Gauss points), used by
+    :func:`tie_correction`
     """
 
     points: np.ndarray
@@ -85,6 +118,7 @@ class Tying:
     gn: np.ndarray
     gk: np.ndarray
     gJ: np.ndarray
+    rule: np.ndarray
 
     @property
     def n_normal(self) -> int:
@@ -96,6 +130,13 @@ class Tying:
         for c in range(6):
             H[:, c, self.off[c]:self.off[c] + self.n[c]] = self.w[c, :, :self.n[c]]
         return H
+
+    def component(self) -> np.ndarray:
+        """(nT,) int: the Voigt component c of each tie-space entry."""
+        c = np.empty(int(self.off[-1]), np.int64)
+        for k in range(6):
+            c[self.off[k]:self.off[k] + self.n[k]] = k
+        return c
 
     def dense(self) -> np.ndarray:
         """H (6, 9, P): Ẽ_c(q) = Σ_p H[c, q, p] E_c(p)."""
@@ -110,13 +151,15 @@ class Tying:
 def tying(full: bool = False) -> Tying:
     """MITC9 tying of Bucalem & Bathe (1993); ``full=True``: all components at the Gauss points
     (reproduces the fully integrated element, used as a check)."""
-    gp, _ = gauss_2d(3)
+    gp, w2 = gauss_2d(3)
     a, b = A_TIE, B_TIE
     la, lb = np.array([-a, a]), np.array([-b, 0.0, b])
+    wa, wb = gauss_1d(2)[1], gauss_1d(3)[1]
     if full:
         sets = {c: (gp, np.eye(9)) for c in range(6)}
         points = gp
         index = {c: np.arange(9) for c in range(6)}
+        rules = {c: w2 for c in range(6)}
     else:
         PA = np.array([(r, s) for r in la for s in lb])  # E_11, E_13
         PB = np.array([(r, s) for r in lb for s in la])  # E_22, E_23
@@ -128,10 +171,13 @@ def tying(full: bool = False) -> Tying:
         iA, iB, iC, iG = np.arange(6), 6 + np.arange(6), 12 + np.arange(4), 16 + np.arange(9)
         index = {0: iA, 4: iA, 1: iB, 3: iB, 5: iC, 2: iG}
         sets = {0: (PA, hA), 4: (PA, hA), 1: (PB, hB), 3: (PB, hB), 5: (PC, hC), 2: (gp, np.eye(9))}
+        rA, rB, rC = np.outer(wa, wb).ravel(), np.outer(wb, wa).ravel(), np.outer(wa, wa).ravel()
+        rules = {0: rA, 4: rA, 1: rB, 3: rB, 5: rC, 2: w2}
     T = max(len(index[c]) for c in range(6))
     pts = np.zeros((6, T), np.int64)
     n = np.zeros(6, np.int64)
     w = np.zeros((6, 9, T))
+    rule = np.zeros((6, T))
     P = len(points)
     used = np.zeros((P, 3), bool)
     for c in range(6):
@@ -139,6 +185,7 @@ def tying(full: bool = False) -> Tying:
         pts[c, :k] = index[c]
         n[c] = k
         w[c, :, :k] = sets[c][1]
+        rule[c, :k] = rules[c]
         i, j = _PAIRS[c]
         used[index[c], i] = used[index[c], j] = True
     ndir = used.sum(axis=1).astype(np.int64)
@@ -165,9 +212,9 @@ def tying(full: bool = False) -> Tying:
                     gk[p, r, gn[p, r]] = off[c] + t
                     gJ[p, r, gn[p, r]] = j if i == K else i
                     gn[p, r] += 1
-    for x in (points, pts, n, w, dirs, ndir, off, gn, gk, gJ):
+    for x in (points, pts, n, w, dirs, ndir, off, gn, gk, gJ, rule):
         x.setflags(write=False)
-    return Tying(points, pts, n, w, dirs, ndir, off, gn, gk, gJ)
+    return Tying(points, pts, n, w, dirs, ndir, off, gn, gk, gJ, rule)
 
 
 def covariant_map(Ginv: np.ndarray) -> np.ndarray:
@@ -196,7 +243,8 @@ class MitcBlock:
     lower Cholesky factor of the level's tied stiffness Ĉ (:func:`tied_stiffness`), or None where
     Ĉ is not positive definite; C (e, z·9, 6, 6), dV (e, z·9): Cartesian stiffness and volume
     weights (z-major); split: ``tie.n_normal`` where Ĉ does not couple the transverse shear ties
-    with the others (L block diagonal: two smaller factor products), else 0
+    with the others (L block diagonal: two smaller factor products), else 0; v (e, z, nT): the
+    consistency correction of the ties (:func:`tie_correction`, in Ĉ and L), or None without it
     """
 
     d: int
@@ -211,6 +259,7 @@ class MitcBlock:
     C: np.ndarray
     dV: np.ndarray
     split: int = 0
+    v: np.ndarray | None = None
 
     @property
     def n_dof(self) -> int:
@@ -259,15 +308,17 @@ def strain_frames(X, H_below, H, points, zeta, frame: str = "center"):
 
 
 def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 0.0, direction=None,
-               n_thickness: int = 3, full: bool = False, frame: str = "center") -> MitcBlock:
+               n_thickness: int = 3, full: bool = False, frame: str = "center", consistent: bool = True) -> MitcBlock:
     """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`;
-    ``frame`` see :func:`strain_frames`)."""
+    ``frame`` see :func:`strain_frames`; ``consistent=False`` leaves out the consistency
+    correction of the tying, module docstring, for comparison)."""
     from .kernel import material_frame
 
     tie = tying(full)
     zeta, wz = gauss_1d(n_thickness)
     gp, w2 = gauss_2d(3)
-    F, M, _, _, _, _, thL = strain_frames(X, H_below, H, tie.points, zeta, frame)  # sampling points
+    F, M, _, _, detP, spP, thL = strain_frames(X, H_below, H, tie.points, zeta, frame)  # sampling points
+    v = np.ascontiguousarray(tie_correction(tie, detP, spP.interpolate(H))) if consistent else None
     Fq, _, _, _, detG, sg, _ = strain_frames(X, H_below, H, gp, zeta, frame)  # Gauss points
     Hq = sg.interpolate(H)
     dV = detG * (w2[:, None] * wz[None, :]) * (0.5 * Hq[..., None])  # (e, q, z)
@@ -278,7 +329,7 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
     Ct = np.ascontiguousarray(0.5 * (Ct + np.swapaxes(Ct, -1, -2)))
     L, split = None, 0
     if np.all(dV > 0):
-        Ch = tied_stiffness(Ct, tie)
+        Ch = tied_stiffness(Ct, tie, v)
         nO = tie.n_normal
         coupling = np.abs(Ch[..., :nO, nO:]).max(axis=(-1, -2))
         if np.all(coupling <= 1e-12 * np.abs(Ch).max(axis=(-1, -2))):  # round-off: material axis 3 = normal
@@ -294,17 +345,51 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
     N, dN, _ = _quad9(tie.points)
     return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
                      np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),
-                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)), split)
+                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)), split, v)
 
 
-def tied_stiffness(Ct: np.ndarray, tie: Tying) -> np.ndarray:
+def tie_correction(tie: Tying, detG: np.ndarray, Hp: np.ndarray) -> np.ndarray:
+    """v (e, z, nT): the consistency correction of the tying (module docstring), from the volume
+    Jacobian ``detG (e, P, z)`` and the layer thickness ``Hp (e, P)`` at the sampling points.
+
+    Per level and component c, with ρ = detG H/2 (volume per unit natural area and level), the
+    Gauss weights dV_q = w_q ρ(q), V = Σ_q dV_q, the weights the tied field gives its ties
+    W_t = Σ_q dV_q h_t(q), and those of the product Gauss rule of the tying points
+    w̄_t = rule_t ρ(p_t) (scaled so that Σ_t w̄_t = V): v_t = (w̄_t − W_t)/V. Zero where ρ is
+    bilinear (straight-edged flat elements of constant thickness) and for ties at the Gauss points
+    (E_33, or every component with ``tying(full=True)``)."""
+    gq = tie.pts[2, :9]  # the Gauss points (E_33 is taken there)
+    _, w2 = gauss_2d(3)
+    rho = detG * (0.5 * Hp)[..., None]  # (e, P, z)
+    dV = w2[:, None] * rho[:, gq]  # (e, q, z)
+    V = dV.sum(axis=1)  # (e, z)
+    W = np.einsum("eqz,cqt->ezct", dV, tie.w)
+    wb = tie.rule[None, None] * rho[:, tie.pts].transpose(0, 3, 1, 2)  # (e, z, c, T)
+    wb *= (V[..., None] / wb.sum(axis=-1))[..., None]
+    v = (wb - W) / V[..., None, None]
+    out = np.empty(v.shape[:2] + (int(tie.off[-1]),))
+    for c in range(6):
+        out[..., tie.off[c]:tie.off[c] + tie.n[c]] = v[..., c, :tie.n[c]]
+    return out
+
+
+def tied_stiffness(Ct: np.ndarray, tie: Tying, v: np.ndarray | None = None) -> np.ndarray:
     """Ĉ (e, z, nT, nT) = Σ_q H_qᵀ C̃_q H_q: the level's stiffness in the tie space (H_q = the
     tying functions at Gauss point q, :meth:`Tying.tie_space`). With the tie-space strains E and
     rows B (nT = 37 for MITC9, against 6 × 9 = 54 Gauss-point rows), Σ_q B̃_qᵀ C̃_q B̃_q = Bᵀ Ĉ B
     and Σ_q B̃_qᵀ S̃_q = Bᵀ (Ĉ E): the material tangent is one syrk with 37 instead of 54 rows per
-    level. Positive definite where every C̃_q is (each H_c has full column rank)."""
+    level. Positive definite where every C̃_q is (each H_c has full column rank). With the
+    consistency correction ``v`` (:func:`tie_correction`) the tied field is H_q P with
+    P = I + U Vᵀ (U (nT, 6) the component indicator, column c of V the v of component c's ties:
+    each tie strain plus the same combination v_cᵀE_c of its component's ties; invertible,
+    det P = Π_c (1 + v_cᵀ1) = 1) and Ĉ = Pᵀ (Σ_q H_qᵀ C̃_q H_q) P, a rank-12 update."""
     H = tie.tie_space()
     C = np.einsum("qck,ezqcd,qdl->ezkl", H, Ct, H, optimize=True)
+    if v is not None:  # Pᵀ C P = C + A Vᵀ + V (Aᵀ + Uᵀ A Vᵀ), A = C U
+        U = (tie.component()[:, None] == np.arange(6)).astype(float)  # (nT, 6)
+        V = v[..., None] * U  # (e, z, nT, 6)
+        A = C @ U
+        C = C + A @ np.swapaxes(V, -1, -2) + V @ (np.swapaxes(A, -1, -2) + (U.T @ A) @ np.swapaxes(V, -1, -2))
     return 0.5 * (C + np.swapaxes(C, -1, -2))
 
 
@@ -312,6 +397,15 @@ def _quad9(points):
     from .shape import quad9
 
     return quad9(points[:, 0], points[:, 1])
+
+
+def _dense_correction(tie: Tying, v: np.ndarray) -> np.ndarray:
+    """The correction ``v (e, z, nT)`` per component and sampling point, ``(e, z, 6, P)``."""
+    Vd = np.zeros(v.shape[:2] + (6, len(tie.points)))
+    for c in range(6):
+        for t in range(tie.n[c]):
+            Vd[:, :, c, tie.pts[c, t]] += v[:, :, tie.off[c] + t]
+    return Vd
 
 
 def natural_gradients(block: MitcBlock, sl: slice = slice(None)) -> np.ndarray:
@@ -347,8 +441,12 @@ def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = T
                                               + np.einsum("ezpk,ezpa->ezpak", g[..., j, :], dphi[..., i]))
                   for i, j in _PAIRS], axis=3)
     Et = np.einsum("cqp,ezpc->ezqc", H, Ev)
-    S = np.einsum("ezqcd,ezqd->ezqc", Ct, Et)
     Bt = np.einsum("cqp,ezpcak->ezqcak", H, B)
+    if block.v is not None:  # consistency correction: the same combination of the ties at every q
+        Vd = _dense_correction(block.tie, block.v[sl])  # (e, z, c, P)
+        Et = Et + np.einsum("ezcp,ezpc->ezc", Vd, Ev)[:, :, None]
+        Bt = Bt + np.einsum("ezcp,ezpcak->ezcak", Vd, B)[:, :, None]
+    S = np.einsum("ezqcd,ezqd->ezqc", Ct, Et)
     e, a = U.shape[:2]
     m = 3 * a
     f = np.einsum("ezqcak,ezqc->eak", Bt, S).reshape(e, m)
@@ -358,6 +456,8 @@ def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = T
     K = np.einsum("ezqcm,ezqcd,ezqdn->emn", Bm, Ct, Bm, optimize=True)
     if nonlinear:
         sv = np.einsum("cqp,ezqc->ezpc", H, S)
+        if block.v is not None:
+            sv = sv + np.einsum("ezcp,ezqc->ezpc", Vd, S)
         sig = np.stack([np.stack([sv[..., 0], sv[..., 5], sv[..., 4]], -1),
                         np.stack([sv[..., 5], sv[..., 1], sv[..., 3]], -1),
                         np.stack([sv[..., 4], sv[..., 3], sv[..., 2]], -1)], -2)
@@ -399,7 +499,8 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
         B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
         GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))
         GT = np.empty_like(GS)
-        Lh = block.L[g0:g1] if lower else np.ascontiguousarray(tied_stiffness(block.Ct[g0:g1], tie))
+        Lh = block.L[g0:g1] if lower else np.ascontiguousarray(
+            tied_stiffness(block.Ct[g0:g1], tie, None if block.v is None else block.v[g0:g1]))
         _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.off,
                         tie.n, tie.dirs, tie.ndir, tie.gn, tie.gk, tie.gJ, Lh, U[s:t], d, nonlinear, tangent, geo,
                         lower, f[s:t], B, GS, GT)
@@ -491,7 +592,10 @@ def tied_strain(X: np.ndarray, H_below: np.ndarray, H: np.ndarray, d: int, U: np
         _, rows, inv = np.unique(np.stack([np.asarray(groups, float), zeta[:, 0, 0]], -1), axis=0,
                                  return_index=True, return_inverse=True)
         inv = inv.ravel()
-    Ffr, M, _, _, _, _, thp = strain_frames(X[rows], H_below[rows], H[rows], tie.points[:16], zeta[rows], frame)
+    Ffr, M, _, _, detP, spP, thp = strain_frames(X[rows], H_below[rows], H[rows], tie.points[:16], zeta[rows], frame)
+    detQ, HQ = _volume_jacobian(X[rows], H_below[rows], H[rows], tie.points[16:], zeta[rows])  # Gauss points
+    v = tie_correction(tie, np.concatenate([detP, detQ], 1),
+                       np.concatenate([spP.interpolate(H[rows]), HQ], 1))[:, 0]  # (u, nT), the point's level
     N, dN, _ = _quad9(tie.points[:16])
     Ev_tie = _strains(Ffr[:, :16, 0], M[:, :16, 0], thp[:, :16, 0], np.broadcast_to(N, (rows.size,) + N.shape),
                       np.broadcast_to(dN, (rows.size,) + dN.shape), U[rows], d, nonlinear)  # (u, 16, 6)
@@ -504,9 +608,24 @@ def tied_strain(X: np.ndarray, H_below: np.ndarray, H: np.ndarray, d: int, U: np
     idx = {0: slice(0, 6), 4: slice(0, 6), 1: slice(6, 12), 3: slice(6, 12), 5: slice(12, 16)}
     Et = np.empty((s, 6))
     for c in range(6):
-        Et[:, c] = Ev[:, 16, c] if c == 2 else np.einsum("st,st->s", h[c], Ev[:, idx[c], c])
+        if c == 2:
+            Et[:, c] = Ev[:, 16, c]
+        else:  # tying functions plus the consistency correction of the point's element and level
+            hc = h[c] + v[inv, tie.off[c]:tie.off[c] + tie.n[c]]
+            Et[:, c] = np.einsum("st,st->s", hc, Ev[:, idx[c], c])
     T = covariant_map(np.linalg.inv(Fp[:, 0]))
     return np.einsum("sVc,sc->sV", T, Et)
+
+
+def _volume_jacobian(X, H_below, H, points, zeta):
+    """detG (e, P, z) = √A det(I − Θ¹ B) at in-plane ``points`` and levels ``zeta`` (as
+    :func:`strain_frames` returns it, without the frames) and the layer thickness Hp (e, P)."""
+    sp = surface_points(X, points[:, 0], points[:, 1])
+    Hp = sp.interpolate(H)
+    t = sp.interpolate(H_below)[..., None] + 0.5 * Hp[..., None] * (zeta + 1.0)  # Θ¹ (e, P, z)
+    B = sp.Bmix
+    trB, detB = B[..., 0, 0] + B[..., 1, 1], B[..., 0, 0] * B[..., 1, 1] - B[..., 0, 1] * B[..., 1, 0]
+    return sp.sqrtA[..., None] * (1.0 - t * trB[..., None] + t * t * detB[..., None]), Hp
 
 
 def _strains(F: np.ndarray, M: np.ndarray, th: np.ndarray, N: np.ndarray, dN: np.ndarray, U: np.ndarray, d: int,
