@@ -379,16 +379,25 @@ def test_tied_strain_at_points_equals_the_kernel_strain(rng):
 
 @pytest.mark.slow
 def test_scordelis_lo_8x8_and_the_converged_value():
-    """Scordelis-Lo 8 × 8 (MITC9, d = 2): within 0.2 % of the converged value of the same
-    continuum model, computed independently with the fully integrated element on 24 × 24
-    (0.3061), and 1.1 % above the conventional 0.3024. Both elements converge to 0.3061 (+1.2 %;
-    the deep-shell theory value is 0.3086, +2.0 %): the 1 % target of issue 14 against 0.3024
-    measures this model's converged value, not the element; so 8 × 8 is checked against the
-    converged value, 0.3024 only to 1.5 %."""
+    """Scordelis-Lo 8 × 8 (MITC9, d = 2, uniform mesh) against the converged value of the same
+    problem as a 3D solid (benchmarks/scordelis_solid.py, docs/vs_solid.md §3: quadratic
+    hexahedra graded towards the free edge, Richardson-extrapolated; tests/test_scordelis_solid.py).
+
+    The example applies the 90 per middle-surface area on the outer face: 3D value 0.30648
+    (+1.35 % of 0.3024); 8 × 8 gives 0.30579 (-0.22 % of it, +1.12 % of 0.3024). The self-weight
+    as a body force (``load = "volume"``) is the problem of the benchmark: 3D value 0.30148
+    (-0.30 % of 0.3024; a load on the middle surface gives the same to 0.003 %); 8 × 8 gives
+    0.30080, within issue 14's 1 % of 0.3024 (-0.53 %). The 1.66 % between the two loads is the
+    eccentricity t/2 of the load's tangential component on the outer face, not an error of the
+    element. (The value 0.3061 once given here as "converged" was a uniform 24 × 24 mesh: uniform
+    meshes converge slowly at the free edge, whose boundary layer is ~t wide; graded meshes give
+    the limits above already on 8 × 8.)"""
     w8 = sb.scordelis_lo(8, "mitc", 2)
-    w_conv = sb.scordelis_lo(24, "full", 2)
-    assert abs(w8 / w_conv - 1) < 0.002
+    assert abs(w8 / sb.SCORDELIS_3D["outer"] - 1) < 0.003
     assert abs(w8 / sb.SCORDELIS_REF - 1) < 0.015
+    w8v = sb.scordelis_lo(8, "mitc", 2, "volume")
+    assert abs(w8v / sb.SCORDELIS_3D["volume"] - 1) < 0.003
+    assert abs(w8v / sb.SCORDELIS_REF - 1) < 0.01
 
 
 @pytest.mark.slow
