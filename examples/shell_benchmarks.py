@@ -79,14 +79,18 @@ def _mid_displacement(res, point, t: float) -> np.ndarray:
     return ps.u[0]
 
 
-def scordelis_lo(n: int, element: str = "mitc", d: int = 2, load: str = "volume") -> float:
-    """Vertical deflection (positive down) at the free-edge midpoint of the n × n quarter model.
+SCORDELIS_R, SCORDELIS_T, SCORDELIS_L = 25.0, 0.25, 50.0
+
+
+def scordelis_lo_spec(n: int, element: str = "mitc", d: int = 2, load: str = "volume"):
+    """The built (not yet run) n × n quarter model of the Scordelis-Lo roof: the mesh's nodes may
+    still be moved (benchmarks/distortion.py) before ``run``.
 
     load: ``"volume"`` (default) the self-weight as a body force 90/t per volume (90 per
     middle-surface area); ``"outer"`` 90 R/R_o per area of the outer (reference) face. They differ by
     1.6 % (benchmarks/scordelis_solid.py, docs/vs_solid.md §3): the vertical load's tangential
     component acting t/2 off the middle surface."""
-    R, t, L = 25.0, 0.25, 50.0
+    R, t, L = SCORDELIS_R, SCORDELIS_T, SCORDELIS_L
     Ro = R + t / 2
     supports = """
 [[supports]]
@@ -119,11 +123,22 @@ value = [0, 0, {-90.0 / t!r}]
 """
     else:
         raise ValueError(f"load: 'outer' or 'volume', not {load!r}")
-    spec = build(parse(_model(n, element, d, R, t, 50.0, 90.0, L / 2, 4.32e8, 0.0, supports, loads), "scordelis.toml"))
-    res = run(spec, None, write_vtu=False)
+    return build(parse(_model(n, element, d, R, t, 50.0, 90.0, L / 2, 4.32e8, 0.0, supports, loads), "scordelis.toml"))
+
+
+def scordelis_lo_deflection(res) -> float:
+    """Vertical deflection (positive down) of a run of ``scordelis_lo_spec`` at the free-edge
+    midpoint (the node nearest to it, on the middle surface)."""
+    t, Ro, a = SCORDELIS_T, SCORDELIS_R + SCORDELIS_T / 2, np.deg2rad(50.0)
+    return -float(_mid_displacement(res, [Ro * np.cos(a), SCORDELIS_L / 2, Ro * np.sin(a)], t)[2])
+
+
+def scordelis_lo(n: int, element: str = "mitc", d: int = 2, load: str = "volume") -> float:
+    """Vertical deflection (positive down) at the free-edge midpoint of the n × n quarter model
+    (``load``: see :func:`scordelis_lo_spec`)."""
+    res = run(scordelis_lo_spec(n, element, d, load), None, write_vtu=False)
     assert res.converged, res.message
-    a = np.deg2rad(50.0)
-    return -float(_mid_displacement(res, [Ro * np.cos(a), L / 2, Ro * np.sin(a)], t)[2])
+    return scordelis_lo_deflection(res)
 
 
 def pinched_cylinder(n: int, element: str = "mitc", d: int = 2) -> float:
