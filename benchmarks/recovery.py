@@ -9,7 +9,10 @@ factorisation pattern is known (second iteration). Recovery, per displacement st
 Gauss levels of every layer, the two patch-recovery products and the evaluation at every point
 the solid ParaView file writes (all elements × layers × 27 lattice points); the patch operators
 themselves (``Recovery(...)``) are built once per model and reported separately.
-Last line: ``recovery/newton=<ratio>`` for the largest mesh (must stay below 1).
+Last line, for the largest mesh: ``recovery/newton=<ratio>`` (the recovery of one state,
+issue 14's "recovery costs less than one Newton iteration": must stay below 1) and
+``with_solid_vtu/newton=<ratio>`` (plus the evaluation at every lattice point of the solid
+ParaView file, an output step's whole stress export).
 """
 from __future__ import annotations
 
@@ -78,10 +81,10 @@ def main() -> None:
         t_solid = best(solid, args.repeat)
         rows.append({"n": n, "dofs": int(op.n_red), "newton_s": round(newton, 4), "setup_s": round(setup, 4),
                      "fields_s": round(t_fields, 4), "fields_plus_solid_vtu_s": round(t_solid, 4),
-                     "ratio": round(t_solid / newton, 3)})
+                     "ratio": round(t_fields / newton, 3), "ratio_with_solid_vtu": round(t_solid / newton, 3)})
         print(json.dumps(rows[-1]), flush=True)
     print(f"load={os.getloadavg()[0]:.2f}")
-    print(f"recovery/newton={rows[-1]['ratio']}")
+    print(f"recovery/newton={rows[-1]['ratio']} with_solid_vtu/newton={rows[-1]['ratio_with_solid_vtu']}")
 
 
 if __name__ == "__main__":

@@ -118,6 +118,12 @@ def rotate_stiffness(c_material: np.ndarray, frame: np.ndarray) -> np.ndarray:
 
     ``frame[..., i, :]`` is the unit vector M_i in Cartesian components; returns ``(..., 6, 6)``.
     """
-    t = voigt_to_tensor(c_material)
-    tc = np.einsum("...iI,...jJ,...kK,...lL,ijkl->...IJKL", frame, frame, frame, frame, t, optimize=True)
-    return tensor_to_voigt(tc)
+    # C' = K C Kᵀ with the 6 × 6 transformation of the Voigt pairs: K_(IJ),(ij) = R_iI R_jJ
+    # (+ R_jI R_iJ for i ≠ j, the two entries a Voigt pair stands for), R = frame - the same sums
+    # as the tensor rotation Σ R_iI R_jJ R_kK R_lL c_ijkl, without the 3⁴ tensors per point
+    v = np.array(VOIGT)
+    i, j = v[:, 0][None, :], v[:, 1][None, :]  # material pair (columns)
+    I, J = v[:, 0][:, None], v[:, 1][:, None]  # Cartesian pair (rows)
+    R = np.asarray(frame, float)
+    K = R[..., i, I] * R[..., j, J] + np.where(i != j, R[..., j, I] * R[..., i, J], 0.0)
+    return np.matmul(np.matmul(K, c_material), np.swapaxes(K, -1, -2))

@@ -326,6 +326,12 @@ def parity(g: int, components: tuple) -> np.ndarray:
                      for comp in components])
 
 
+def _at_points(N: np.ndarray, nodal: np.ndarray) -> np.ndarray:
+    """Nodal values ``(p, 9, …)`` interpolated with the shape functions ``N (p, 9)`` of each point."""
+    p = N.shape[0]
+    return np.matmul(N[:, None], nodal.reshape(p, 9, -1))[:, 0].reshape((p,) + nodal.shape[2:])
+
+
 @dataclass
 class RecoveryFields:
     """Nodal fields of one displacement state: per layer k, the SPR-smoothed stress (Voigt,
@@ -446,9 +452,9 @@ class Recovery:
         T = np.stack([t1, t2], -1)  # (p, 3, 2)
         gradN = _surface_gradients(spq)[:, 0]  # (p, 9, 3)
         A = spq.A[:, 0]
-        Aup = np.einsum("pia,pab->pib", A, np.linalg.inv(np.einsum("pia,pib->pab", A, A)))
-        Bc = np.einsum("pil,pla,pja->pij", A, spq.Bmix[:, 0], Aup)  # B^λ_α A_λ ⊗ A^α
-        Bt = np.einsum("pia,pij,pjb->pab", T, Bc, T)
+        Aup = np.matmul(A, np.linalg.inv(np.matmul(np.swapaxes(A, 1, 2), A)))
+        Bc = np.matmul(np.matmul(A, spq.Bmix[:, 0]), np.swapaxes(Aup, 1, 2))  # B^λ_α A_λ ⊗ A^α
+        Bt = np.matmul(np.matmul(np.swapaxes(T, 1, 2), Bc), T)
         Bt = 0.5 * (Bt + np.swapaxes(Bt, 1, 2))
         stacks = m.element_stack[elements]
         layers = np.asarray(layers, np.int64)
@@ -473,26 +479,28 @@ class Recovery:
                 zl = levels(ly.directors)
                 nl = zl.size
                 H = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
-                S_at = _sym(np.einsum("pn,pnlv->plv", spq.N[sel, 0], f.S[k][conn[sel]]))  # (p, nl, 3, 3)
+                S_at = _sym(_at_points(spq.N[sel, 0], f.S[k][conn[sel]]))  # (p, nl, 3, 3)
                 # D_α = ∂σ_αβ/∂s_β (p, nl, 2) interpolated from its nodal values (second pass): the
                 # derivative of the interpolated nodal stress at the point itself depends on the
                 # element at its nodes and converged only at first order (+4.7/+2.3/+1.1 % of the
                 # interface shear of benchmarks/vs_solid.py's plate at a node on 8/16/32 elements)
-                Da = np.einsum("pn,pnli,pia->pla", spq.N[sel, 0], f.D[k][conn[sel]], T[sel])
-                Ev = np.einsum("pai,pali->pl", gradN[sel], f.D[k][conn[sel]])  # ∂D_β/∂s_β (p, nl)
+                Dn = f.D[k][conn[sel]]  # (p, 9, nl, 3)
+                Da = np.matmul(_at_points(spq.N[sel, 0], Dn), T[sel])
+                Ev = np.matmul(np.swapaxes(Dn, 1, 2).reshape(ps_, nl, 27),
+                               gradN[sel].reshape(ps_, 27, 1))[..., 0]  # ∂D_β/∂s_β (p, nl)
                 Sin = np.einsum("pia,plij,pjb->plab", T[sel], S_at, T[sel], optimize=True)  # (p, nl, 2, 2), tangent frame
                 Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
 
                 def G_at(s):  # G = μ F - K at layer fractions s (p, q)
-                    a1 = np.einsum("pqm,ml->pql", s[..., None] ** (np.arange(nl) + 1) / (np.arange(nl) + 1), Vinv)
-                    L = np.einsum("pqm,ml->pql", s[..., None] ** np.arange(nl), Vinv)
-                    F = F_below[:, None] + H[:, None] * np.einsum("pql,pl->pq", a1, Ev)
+                    a1 = np.matmul(s[..., None] ** (np.arange(nl) + 1) / (np.arange(nl) + 1), Vinv)
+                    L = np.matmul(s[..., None] ** np.arange(nl), Vinv)
+                    F = F_below[:, None] + H[:, None] * np.matmul(a1, Ev[..., None])[..., 0]
                     z = z0[:, None] + s * H[:, None]
                     M = I2 - z[..., None, None] * Bs[:, None]
                     mu = np.linalg.det(M)
                     adj = np.trace(M, axis1=-2, axis2=-1)[..., None, None] * I2 - M
-                    S2 = np.einsum("pql,plab->pqab", L, Sin)
-                    K = np.einsum("pab,pqbc,pqca->pq", Bs, adj, S2)
+                    S2 = np.matmul(L, Sin.reshape(ps_, nl, 4)).reshape(L.shape[:2] + (2, 2))
+                    K = np.trace(np.matmul(np.matmul(Bs[:, None], adj), S2), axis1=-2, axis2=-1)
                     return mu * F - K
 
                 def integral(s_end):  # ∫ over the layer from its bottom to fraction s_end (p,)

@@ -636,16 +636,20 @@ def _strains(F: np.ndarray, M: np.ndarray, th: np.ndarray, N: np.ndarray, dN: np
     s, p = th.shape
     l = np.arange(d + 1)
     pw, dpw = th[..., None] ** l, np.where(l > 0, l * th[..., None] ** np.maximum(l - 1, 0), 0.0)
-    d12 = np.einsum("spna,spl->spnla", dN, pw)
-    d3 = np.einsum("spn,spl->spnl", N, dpw)[..., None]
-    dphi = np.concatenate([d12, d3], -1).reshape(s, p, 9 * (d + 1), 3)
-    dphi = np.einsum("spai,spib->spab", dphi, M)
+    # D_ik = Σ_a ∂φ_a,i U_ak with ∂φ_(n,l) = (∂_α N_n Θ^l, N_n l Θ^(l-1)) M: contract the
+    # directors first (W_n = Σ_l Θ^l U_nl, V_n = Σ_l l Θ^(l-1) U_nl), then the nodes, then M -
+    # small batched products instead of the (s, p, 9(d+1), 3) gradient array (the stress recovery
+    # evaluates this at every Gauss point of every level)
+    U4 = U.reshape(s, 9, d + 1, 3)
+    W = np.swapaxes(np.matmul(pw[:, None], U4), 1, 2)  # (s, p, 9, 3)
+    V = np.swapaxes(np.matmul(dpw[:, None], U4), 1, 2)
+    C = np.concatenate([np.matmul(np.swapaxes(dN, -1, -2), W), np.matmul(N[..., None, :], V)], axis=-2)  # (s, p, 3, 3)
+    D = np.matmul(np.swapaxes(M, -1, -2), C)  # D_ik = Σ_a dphi_ai U_ak
     Gc = np.swapaxes(F, -1, -2)
-    D = np.einsum("spai,sak->spik", dphi, U)
-    GD = np.einsum("spik,spjk->spij", Gc, D)
+    GD = np.matmul(Gc, np.swapaxes(D, -1, -2))
     E = 0.5 * (GD + np.swapaxes(GD, -1, -2))
     if nonlinear:
-        E = E + 0.5 * np.einsum("spik,spjk->spij", D, D)
+        E = E + 0.5 * np.matmul(D, np.swapaxes(D, -1, -2))
     return np.stack([E[..., i, j] * (1.0 if i == j else 2.0) for i, j in _PAIRS], axis=-1)
 
 

@@ -159,7 +159,7 @@ def interface_form(problem: Problem) -> bool:
     :mod:`layershell.cohesive` and penalty contact, the separation linear in u). On a linear
     bulk at equilibrium (f_I = λF̂ − K_L u, K_L symmetric) it equals Gutiérrez's form exactly,
     which is kept there (linear in the unknowns)."""
-    if not problem.model.nonlinear:
+    if not getattr(getattr(problem, "model", None), "nonlinear", False):
         return False
     from ..cohesive import CohesiveBlock
 
