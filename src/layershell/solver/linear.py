@@ -224,6 +224,7 @@ class PardisoSymmetric:
         self._decisions = decisions
         self._indptr: np.ndarray | None = None
         self._indices: np.ndarray | None = None
+        self._pattern_ref: tuple = (None, None)  # the index arrays last seen (identity check)
         self._A: sp.csr_matrix | None = None  # the matrix of the factorisation in place
         self.flops = 0.0  # of a numerical factorisation, as the analysis reported it
         self.factor_entries = 0
@@ -356,8 +357,11 @@ class PardisoSymmetric:
 
         A = self._check(self.matrix(K))
         b = np.asfortranarray(r, dtype=float)
-        same = (self._indptr is not None and np.array_equal(A.indptr, self._indptr)
-                and np.array_equal(A.indices, self._indices))
+        # the pattern of the analysis in place? The assembler hands out the same index arrays for
+        # one pattern (checked by identity first: comparing 4 M indices took 3.5 % of the DCB's run)
+        same = self._indptr is not None and (
+            (A.indptr is self._pattern_ref[0] and A.indices is self._pattern_ref[1])
+            or (np.array_equal(A.indptr, self._indptr) and np.array_equal(A.indices, self._indices)))
         try:
             if not same:
                 if self._indptr is not None:
@@ -367,6 +371,7 @@ class PardisoSymmetric:
                 self._indptr, self._indices = A.indptr.copy(), A.indices.copy()
                 ip = self._s.iparm  # what the analysis reported: factorisation MFLOP, entries of the factor
                 self.flops, self.factor_entries = 1e6 * max(int(ip[18]), 0), max(int(ip[17]), 0)
+            self._pattern_ref = (A.indptr, A.indices)
             self._A = None
             self._raw(A, 22, b)  # numerical factorisation
             self._A = A  # the matrix factorised (phase 33 refines on it after perturbed pivots)
