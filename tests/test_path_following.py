@@ -482,3 +482,20 @@ def test_complete_failure_needs_a_dissipating_increment():
     assert not complete_failure(1e-4, -0.01, 0.6, -1e-14, 10.0, 1e-3)
     assert not complete_failure(1e-4, +0.01, 0.6, 0.02, 10.0, 1e-3)
     assert not complete_failure(0.3, -0.01, 0.6, 0.02, 10.0, 1e-3)
+
+
+def test_a_path_that_no_longer_advances_is_stopped():
+    """``crawling``: 25 increments within end_fraction × the peak of λ that together dissipated
+    less than end_fraction of the energy dissipated so far - the increments have been cut to
+    nothing (the nonlinear §5.1 plate with friction crawled at λ = 0.8953 through increments of
+    10⁻⁷ of the first). Not on a plateau of the load that dissipates (a long bond debonding at
+    P_u), not while λ moves, not before 25 increments, not when switched off."""
+    from layershell.solver.arclength import crawling
+
+    lam = list(0.8953 + 1e-7 * np.arange(25))
+    tiny = [2e-7] * 25
+    assert crawling(lam, tiny, 25, 0.8953, 0.06, 1e-3)
+    assert not crawling(lam, [2e-4] * 25, 25, 0.8953, 0.06, 1e-3)  # a dissipating plateau
+    assert not crawling(list(np.linspace(0.88, 0.8953, 25)), tiny, 25, 0.8953, 0.06, 1e-3)  # λ moves
+    assert not crawling(lam[1:], tiny[1:], 25, 0.8953, 0.06, 1e-3)  # too few
+    assert not crawling(lam, tiny, 0, 0.8953, 0.06, 1e-3)  # switched off

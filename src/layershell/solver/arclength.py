@@ -472,7 +472,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     probes_prev = watch(u, lam) if watch is not None else None
     scales = probe_scales({}, probes_prev)
     end = ps.lambda_end
-    recent: list[float] = []  # λ of the last accepted increments (stalled())
+    recent: list[float] = []  # λ of the last accepted increments (stalled(), crawling())
+    recent_dG: list[float] = []  # and their |ΔG| (crawling())
     itf_form = interface_form(problem)  # the dissipation measured at the interfaces
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
@@ -631,6 +632,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.finished = (to_end or lam >= end
                            or complete_failure(lam, dlam, st.lam_peak, dG, st.dissipated, ps.end_fraction))
         recent = (recent + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+        recent_dG = (recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+        crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
+                 and crawling(recent, recent_dG, ps.stall_increments, st.lam_peak, st.dissipated, ps.end_fraction))
         if (not st.finished and st.mode != "load"
                 and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
             st.finished = True
@@ -652,6 +656,15 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         yield res
         if st.finished:
             return
+        if crawl:  # after the step is kept: the path cannot go on from it
+            raise ConvergenceError(
+                f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
+                f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
+                f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
+                f"dissipated so far; the constrained iterations fail at every larger increment. The last converged state "
+                f"is kept. Where the path is expected to rise to the design load, load control (control = 'load') with "
+                f"[steps] stabilize passes such a state; else refine the mesh at the debonding front",
+                lam, residuals[-1] if residuals else float("nan"))
 
 
 #: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
@@ -667,6 +680,20 @@ def stalled(recent: list[float], n: int, lam_peak: float, end_fraction: float) -
     λ never falls below ``end_fraction`` × the peak."""
     return (n > 0 and len(recent) >= n and lam_peak > 0 and max(abs(x) for x in recent) <= STALL_FRACTION * lam_peak
             and max(recent) - min(recent) <= end_fraction * lam_peak)
+
+
+def crawling(recent: list[float], recent_dG: list[float], n: int, lam_peak: float, dissipated: float,
+             end_fraction: float) -> bool:
+    """Has the path stopped advancing (anywhere, unlike :func:`stalled`)? Over the last ``n``
+    accepted increments λ stayed within ``end_fraction`` × its peak and they dissipated less
+    than ``end_fraction`` of the energy dissipated so far: the increments have been cut to
+    nothing. (A plateau of the load, such as a long bond's debonding at P_u, dissipates a good
+    share per increment and goes on.) The geometrically nonlinear §5.1 plate with friction
+    (MITC9, 6 × 6) crawled at λ = 0.8953 through increments of 10⁻⁷ of the first; it reaches
+    λ = 1 without friction or without geometric nonlinearity."""
+    return (n > 0 and len(recent) >= n and len(recent_dG) >= n and lam_peak > 0 and dissipated > 0
+            and max(recent) - min(recent) <= end_fraction * lam_peak
+            and sum(recent_dG) <= end_fraction * dissipated)
 
 
 def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissipated: float,
