@@ -466,8 +466,11 @@ class _Assembler:
             raise NotImplementedError("the distributed problem forms the reduced tangent only (evaluate_reduced)")
         return self.pb.internal_force(u_full, False), None
 
-    def evaluate_reduced(self, u_full: np.ndarray, op):
-        """``(f_int, A)``: A = Tᵀ K T assembled in the PETSc matrix (the handle for ``_Solver``)."""
+    def evaluate_reduced(self, u_full: np.ndarray, op, forces: bool = True):
+        """``(f_int, A)``: A = Tᵀ K T assembled in the PETSc matrix (the handle for ``_Solver``).
+        ``forces``: as the serial :meth:`layershell.assembly.Assembler.evaluate_reduced`'s (the
+        serial solvers pass False where they do not read f_int); the ranks compute the force with
+        the tangent in one pass anyway, so it is always returned."""
         if op is not self.pb.op:
             raise UnsupportedModelError("the constraint operator changed during a distributed run")
         return self.pb.internal_force(u_full, True), self.pb.A
