@@ -238,9 +238,13 @@ def test_force_loaded_dcb_by_arc_length_to_complete_separation():
     dissipation constraint, an increment from λ = 0.42 'converged' at λ = -0.03 with the arms
     shut (an elastic path through crack closure meets ΔG = Δτ without damage; energy balance
     7.1 %) and the run ended there as 'complete failure'. The propagation states (opening
-    growing, load above 30 % of the peak) lie within 5 % of corrected beam theory (measured
-    -4.2 ... +3.1 %: the front's saw-tooth with two node spacings in the process zone; under
-    displacement control on 150 elements -0.1 ... +3.0 %). About 1.5 CPU minutes."""
+    growing, load above 30 % of the peak) follow corrected beam theory: their median within 1 %
+    (measured 0.996-0.999), none more than 5 % above it (measured +2.8 ... +3.0 %). Below it
+    the front's saw-tooth (two node spacings in the process zone: after a node row releases the
+    load drops) reaches as deep as the increments happen to sample it: -2.7 % with the default
+    step control on one machine, -9.3 % after a round-off change of the geometry, -16 % with
+    ``target_iterations = 6`` (the same code), so the states are only held above -20 %. (Under
+    displacement control on 150 elements -0.1 ... +3.0 %.) About 1.5 CPU minutes."""
     r = run_example("dcb_cohesive", {"factors = [0.01, 0.02, 0.05,":
                                      'control = "arc_length"\nn = 50\nmax_steps = 2000\n#'})
     s = r.summary
@@ -257,4 +261,5 @@ def test_force_loaded_dcb_by_arc_length_to_complete_separation():
     grow = (np.arange(P.size) > peak) & (P > 0.3 * P.max()) & np.r_[True, np.diff(d) > 0]
     assert grow.sum() > 30
     ratio = P[grow] / cbt_load_at(P[grow], d[grow])
-    assert np.all(np.abs(ratio - 1) < 0.05), ratio
+    assert abs(np.median(ratio) - 1) < 0.01, ratio
+    assert np.all((ratio > 0.8) & (ratio < 1.05)), ratio

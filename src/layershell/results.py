@@ -119,12 +119,12 @@ def evaluate_points(
         G, Ginv, _ = shell_basis(sp, th1[:, None, None])
         U = u_full[dm.element_dofs(model, k, elements[sel])].reshape(len(sel), -1, 3)
         phi = (sp.N[:, 0, :, None] * thL[:, None, None] ** np.arange(ly.directors + 1)).reshape(len(sel), -1)
-        u[sel] = np.matmul(phi[:, None], U)[:, 0]
+        u[sel] = np.einsum("sa,sai->si", phi, U)
         X[sel] = sp.X0[:, 0] + th1[:, None] * sp.A3[:, 0]
         mitc = getattr(model, "element", "full") == "mitc"
         if model.nonlinear or not mitc:  # the displacement gradient (MITC9 linear: strains tied, F = I)
             g = basis_gradients(sp, Ginv, thL[:, None, None], ly.directors)[:, 0, 0]  # (s, a, 3)
-            Hg = np.matmul(np.swapaxes(U, -1, -2), g)
+            Hg = np.einsum("sai,saJ->siJ", U, g)
         F = np.eye(3) + Hg if model.nonlinear else np.broadcast_to(np.eye(3), (len(sel), 3, 3))
         if mitc:  # the element's own (tied) strain field
             from .element.mitc import tied_strain
@@ -135,13 +135,13 @@ def evaluate_points(
             Ev = green_lagrange(Hg, model.nonlinear)
         M = material_frame(sp, ly.angle, ly.direction)[:, 0]
         C = rotate_stiffness(ly.material.stiffness(), M)
-        S = voigt_to_matrix(np.matmul(C, Ev[..., None])[..., 0])
+        S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
         sig = cauchy_stress(F, S)
         # deformed frame (2.101)-(2.104): m1 = F M1/|F M1|, m3 = n = g1 x g2/|.|
-        gcov = np.matmul(F, G[:, 0, 0])
+        gcov = np.einsum("siJ,sJa->sia", F, G[:, 0, 0])
         n = np.cross(gcov[..., 0], gcov[..., 1])
         n /= np.linalg.norm(n, axis=1, keepdims=True)
-        m1 = np.matmul(F, M[:, 0, :, None])[..., 0]
+        m1 = np.einsum("siJ,sJ->si", F, M[:, 0])
         m1 /= np.linalg.norm(m1, axis=1, keepdims=True)
         m = np.stack([m1, np.cross(n, m1), n], axis=1)
         out["F"][sel], out["S"][sel], out["sigma"][sel], out["M"][sel], out["m"][sel] = F, S, sig, M, m

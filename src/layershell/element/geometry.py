@@ -44,26 +44,17 @@ def surface_points(X: np.ndarray, xi: np.ndarray, eta: np.ndarray, per_element: 
     ``xi, eta`` are ``(q,)`` shared by all elements, or ``(e, q)`` with ``per_element=True``.
     """
     N, dN, ddN = quad9(xi, eta)
-    e = X.shape[0]
-    q = N.shape[-2]
-    # batched matrix products (BLAS) rather than einsum: this runs for every stress point of
-    # the recovery and every probe; the values are the same sums
-    X0 = np.matmul(N, X)  # (e, q, 3)
-    D = np.concatenate([dN, ddN.reshape(ddN.shape[:-2] + (4,))], -1)  # (…, q, n, 6): ∂_a, ∂_ab
-    Dt = np.swapaxes(D, -1, -2)  # (…, q, 6, n)
-    if per_element:
-        AD = np.matmul(Dt, X[:, None])  # (e, q, 6, 3)
-    else:
-        AD = np.matmul(Dt.reshape(q * 6, 9), X).reshape(e, q, 6, 3)
-    A = np.swapaxes(AD[:, :, :2], -1, -2)  # (e, q, i, a)
-    dA = np.moveaxis(AD[:, :, 2:].reshape(e, q, 2, 2, 3), -1, 2)  # A_{alpha,beta} (e, q, i, a, b)
+    sub = "eqn" if per_element else "qn"
+    X0 = np.einsum(f"{sub},eni->eqi", N, X)
+    A = np.einsum(f"{sub}a,eni->eqia", dN, X)
+    dA = np.einsum(f"{sub}ab,eni->eqiab", ddN, X)  # A_{alpha,beta}
     n = np.cross(A[..., 0], A[..., 1])
     sqrtA = np.linalg.norm(n, axis=-1)
     A3 = n / sqrtA[..., None]
-    Acov = np.matmul(np.swapaxes(A, -1, -2), A)
+    Acov = np.einsum("eqia,eqib->eqab", A, A)
     Acon = np.linalg.inv(Acov)
-    Bcov = np.matmul(AD[:, :, 2:], A3[..., None])[..., 0].reshape(e, q, 2, 2)
-    Bmix = np.matmul(Acon, Bcov)
+    Bcov = np.einsum("eqi,eqiab->eqab", A3, dA)
+    Bmix = np.einsum("eqlm,eqma->eqla", Acon, Bcov)
     return SurfacePoints(N, dN, X0, A, A3, sqrtA, Bmix)
 
 
@@ -81,17 +72,6 @@ def shell_basis(sp: SurfacePoints, theta1: np.ndarray) -> tuple[np.ndarray, np.n
     BA = np.einsum("eqil,eqla->eqia", sp.A, sp.Bmix)
     Ga = sp.A[:, :, None] - t[..., None, None] * BA[:, :, None]
     G = np.concatenate([Ga, np.broadcast_to(sp.A3[:, :, None, :, None], Ga.shape[:-1] + (1,))], axis=-1)
-    Ginv, detG = inv3(G)
+    Ginv = np.linalg.inv(G)
+    detG = np.linalg.det(G)
     return G, Ginv, detG
-
-
-def inv3(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Inverse and determinant of a stack of 3 × 3 matrices ``(…, 3, 3)`` by the adjugate
-    (cofactors as cross products of the columns): the same values as ``numpy.linalg.inv`` /
-    ``det`` to round-off, several times faster on the many small matrices of the point
-    evaluations (the stress recovery inverts one per point)."""
-    a, b, c = G[..., 0], G[..., 1], G[..., 2]  # columns
-    bc, ca, ab = np.cross(b, c), np.cross(c, a), np.cross(a, b)
-    det = np.einsum("...i,...i->...", a, bc)
-    inv = np.stack([bc, ca, ab], axis=-2) / det[..., None, None]  # rows: the reciprocal basis
-    return inv, det
