@@ -89,7 +89,7 @@ def _jsonable(obj):
 #: (the stabilisation, the relaxed jumps and the solver's counters included - a restart once
 #: dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
 SUMMARY_KEYS = ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end",
-                "stabilized", "relaxations", "active_set", "linear_solves")
+                "stabilized", "relaxations", "active_set", "linear_solves", "energy_balance_warned")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,
