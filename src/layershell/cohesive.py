@@ -321,6 +321,49 @@ def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.n
     return np.where(d > 0, W - 0.5 * (1.0 - d) * K * lam**2, 0.0)
 
 
+#: sub-steps of :func:`dissipation_increment`
+LEDGER_SUBSTEPS = 16
+
+
+def dissipation_increment(delta0: np.ndarray, delta1: np.ndarray, n: np.ndarray, d0: np.ndarray, d1: np.ndarray,
+                          K: float, law: CohesiveLaw, m: int = LEDGER_SUBSTEPS) -> np.ndarray:
+    """Energy per area dissipated in a step in which the separation goes from ``delta0`` (the last
+    converged state, damage ``d0``) to ``delta1`` (damage ``d1``): ∫ ½Kλ² dd along the straight
+    separation path between them (the path the trapezoidal external work assumes), in ``m``
+    sub-steps. In each the damage follows the law from the one before (:func:`point_response`;
+    the last sub-step ends at ``d1``) and the sub-step's dissipation is the closed form
+    :func:`dissipated` at the mode ratio of its midpoint - exact on a proportional path, whatever
+    the step. Zero where the damage does not grow.
+
+    The closed form at the end-of-step mode ratio alone (the earlier ledger) is of first order
+    where the mode ratio turns within a step, and it books a point that fails within the step
+    at the mode ratio of the step's end instead of that of its failure. On a single point whose
+    separation turns from opening to shear, 50 steps: 0.5 % against 0.009 % of the dissipation
+    (tests/test_enf.py); on the force-loaded MMB with increments a tenth of the default: energy
+    balance 0.97 % against 0.12 % (tests/test_mmb.py). Where a front point passes from onset to
+    failure within one or two long increments its path between them is not straight either: the
+    default MMB still books about 11 % too little (13 % before; the run warns)."""
+    d0, d1 = np.asarray(d0, float), np.asarray(d1, float)
+    grow = d1 > d0
+    out = np.zeros(d1.shape)
+    if not np.any(grow):
+        return out
+    x0, x1, nn = delta0[grow], delta1[grow], np.broadcast_to(n, delta1.shape)[grow]
+    dmax, d = d1[grow], d0[grow]
+    total = np.zeros_like(d)
+    for k in range(1, m + 1):
+        if k < m:
+            _, dk, _ = point_response(x0 + (k / m) * (x1 - x0), nn, d, K, law, tangent=False)
+            dk = np.minimum(dk, dmax)
+        else:
+            dk = dmax
+        B = separation_measures(x0 + ((k - 0.5) / m) * (x1 - x0), nn)[3]
+        total += dissipated(dk, B, K, law) - dissipated(d, B, K, law)
+        d = dk
+    out[grow] = total
+    return out
+
+
 # ---------------------------------------------------------------------- interface block
 @dataclass
 class CohesiveBlock:
