@@ -137,7 +137,7 @@ def test_dissipation_constraint_of_a_geometrically_nonlinear_plate_is_the_fractu
     arc length) dissipate what the constraint asks for: ΔG of each increment against the energy
     the interface points' damage released in it by the law (the ledger's dissipated_fracture +
     friction, an independent count: each point's damage integrated along its separation path,
-    cohesive.dissipation_increment). Gutiérrez's ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) takes the stored energy
+    cohesive.path_dissipation). Gutiérrez's ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) takes the stored energy
     to be ½λF̂ᵀu, true of a linear bulk only; on this plate it misses by −1.5 / −2.8 / −7.8 % on
     the first three such increments (the example's element), growing with the deflection, and
     'dissipated' -4e-6 on an elastic one. The interface form (solver/arclength.py

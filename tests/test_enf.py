@@ -308,10 +308,10 @@ def _ledger_on_turning_path(n: int):
     """A single cohesive point whose separation turns from pure opening to pure shear while it
     grows from 0 to 0.03 mm in ``n`` steps (non-proportional: the mode ratio changes while the
     point softens): the fracture energy booked by the ledger's rule
-    (:func:`~layershell.cohesive.dissipation_increment`, solver/interface_state.py) and by the
+    (:func:`~layershell.cohesive.path_dissipation`, solver/interface_state.py) and by the
     earlier rule, the closed form :func:`~layershell.cohesive.dissipated` at the mode ratio of
     each step's end."""
-    from layershell.cohesive import (CohesiveLaw, dissipated, dissipation_increment, point_response,
+    from layershell.cohesive import (CohesiveLaw, dissipated, path_dissipation, point_response,
                                      separation_measures)
 
     law = CohesiveLaw(G_Ic=G_IC, G_IIc=G_IIC, sigma_max=SIGMA_MAX, tau_max=SIGMA_MAX, eta=ETA)
@@ -329,7 +329,7 @@ def _ledger_on_turning_path(n: int):
         _, d, _ = point_response(x, nrm, d_old, K, law, tangent=False)
         B = separation_measures(x, nrm)[3]
         d = np.maximum(d, d_old)
-        booked += float(dissipation_increment(x_prev, x, nrm, d_old, d, K, law).sum())
+        booked += float(path_dissipation(x_prev, x, nrm, d_old, d, K, law).sum())
         end_ratio += float(np.where(d > d_old, dissipated(d, B, K, law) - dissipated(d_old, B, K, law), 0.0).sum())
         x_prev, d_old = x, d
     return booked, end_ratio, float(d_old[0])

@@ -19,6 +19,7 @@ import pytest
 from scipy.optimize import brentq
 
 from helpers import run_example
+from test_dcb import cbt_compliance as dcb_compliance
 from test_enf import B_W, E11, H, bk, chi, enf_compliance
 
 A0, L_HALF = 35.0, 50.0
@@ -26,13 +27,9 @@ F_END, F_MID = 300.0, 660.0  # forces at λ = 1 (examples/mmb_cohesive.toml)
 P_I, P_II = F_END - F_MID / 4, F_MID
 
 
-def dcb_compliance(a):
-    """Opening of the DCB pair per force, corrected beam theory (Williams 1989)."""
-    return 8 * (a + chi() * H) ** 3 / (E11 * B_W * H**3)
-
-
 def mmb_compliance(a):
-    """D / λ of the MMB forces at crack length ``a`` (< L)."""
+    """D / λ of the MMB forces at crack length ``a`` (< L); the DCB pair's opening per force by
+    corrected beam theory (Williams 1989; the DCB's arms and material are the MMB's)."""
     return P_I**2 * dcb_compliance(a) + P_II**2 * enf_compliance(a)
 
 

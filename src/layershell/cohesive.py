@@ -321,12 +321,12 @@ def dissipated(d: np.ndarray, B: np.ndarray, K: float, law: CohesiveLaw) -> np.n
     return np.where(d > 0, W - 0.5 * (1.0 - d) * K * lam**2, 0.0)
 
 
-#: sub-steps of :func:`dissipation_increment`
+#: sub-steps of :func:`path_dissipation`
 LEDGER_SUBSTEPS = 16
 
 
-def dissipation_increment(delta0: np.ndarray, delta1: np.ndarray, n: np.ndarray, d0: np.ndarray, d1: np.ndarray,
-                          K: float, law: CohesiveLaw, m: int = LEDGER_SUBSTEPS) -> np.ndarray:
+def path_dissipation(delta0: np.ndarray, delta1: np.ndarray, n: np.ndarray, d0: np.ndarray, d1: np.ndarray,
+                     K: float, law: CohesiveLaw, m: int = LEDGER_SUBSTEPS) -> np.ndarray:
     """Energy per area dissipated in a step in which the separation goes from ``delta0`` (the last
     converged state, damage ``d0``) to ``delta1`` (damage ``d1``): ∫ ½Kλ² dd along the straight
     separation path between them (the path the trapezoidal external work assumes), in ``m``

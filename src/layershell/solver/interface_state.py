@@ -25,7 +25,7 @@ from dataclasses import dataclass, field, fields, replace
 
 import numpy as np
 
-from ..cohesive import (FULL_DAMAGE, CohesiveBlock, CohesiveLaw, cohesive_traction_energy, dissipation_increment,
+from ..cohesive import (FULL_DAMAGE, CohesiveBlock, CohesiveLaw, cohesive_traction_energy, path_dissipation,
                         separation_measures)
 from ..contact import ContactBlock, friction_shape_inverse
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_delam, tau_slide
@@ -77,8 +77,8 @@ class CohesiveRun:
         d_prev = blk.dv_old if blk.dv_old is not None else blk.d_old  # acting damage of the last commit
         grow = d > d_prev
         # fracture: ∫ ½Kλ² dd along the separation path from the last commit (sub-stepped, the
-        # mode ratio may turn: cohesive.dissipation_increment)
-        frac = dissipation_increment(self.delta, delta, cb.A3, d_prev, d, blk.K, law)
+        # mode ratio may turn: cohesive.path_dissipation)
+        frac = path_dissipation(self.delta, delta, cb.A3, d_prev, d, blk.K, law)
         # viscous regularisation: the work of the cohesive tractions on the separation increment
         # (trapezoid, the rule of the external work) less the change of the stored energy is the
         # whole dissipation of the step; beyond the closed form of the rate-independent law it is
