@@ -499,3 +499,29 @@ def test_a_path_that_no_longer_advances_is_stopped():
     assert not crawling(list(np.linspace(0.88, 0.8953, 25)), tiny, 25, 0.8953, 0.06, 1e-3)  # λ moves
     assert not crawling(lam[1:], tiny[1:], 25, 0.8953, 0.06, 1e-3)  # too few
     assert not crawling(lam, tiny, 0, 0.8953, 0.06, 1e-3)  # switched off
+
+
+def test_energy_error_of_an_increment_and_when_the_step_control_acts():
+    """arclength.increment_energy_error and energy_control on ledger terms (W, D, E, E/S): the
+    error an increment adds relative to the larger of its work and its dissipation (a floor of
+    ENERGY_FLOOR × W for increments without energy); the control acts only where the run's balance
+    error is above 0.5 % and the increment made it larger, and its tolerance falls from the full
+    value at 0.5 % to a tenth at 1 %."""
+    from layershell.solver.arclength import ENERGY_FLOOR, energy_control, increment_energy_error
+
+    assert increment_energy_error((100.0, 10.0, 0.6, 0.006), (110.0, 14.0, 0.8, 0.8 / 110)) == pytest.approx(0.02)
+    # a snap-back: the work falls by 2 while 5 are dissipated - the dissipation is the scale
+    assert increment_energy_error((100.0, 10.0, 0.5, 0.005), (98.0, 15.0, 0.6, 0.006)) == pytest.approx(0.1 / 5)
+    assert increment_energy_error((100.0, 10.0, -0.5, -0.005), (98.0, 15.0, -0.6, -0.006)) == pytest.approx(0.1 / 5)
+    assert increment_energy_error((100.0, 10.0, 0.5, 0.005), (100.0, 10.0, 0.5 + 1e-6, 0.005)) == pytest.approx(
+        1e-6 / (ENERGY_FLOOR * 100.0))
+    assert increment_energy_error(None, (1.0, 0.0, 0.0, 0.0)) == 0.0
+    # no action below 0.5 %, nor where the increment reduced the error
+    assert energy_control((100.0, 10.0, 0.3, 0.003), (110.0, 14.0, 0.5, 0.5 / 110), 0.02) == 0.0
+    assert energy_control((100.0, 10.0, 0.8, 0.008), (110.0, 14.0, 0.7, 0.7 / 110), 0.02) == 0.0
+    assert energy_control(None, (110.0, 14.0, 0.7, 0.7 / 110), 0.02) == 0.0
+    # 2 % of the increment's work at a run error of 0.6 %: the tolerance there is 0.8 × 2 %
+    assert energy_control((100.0, 10.0, 0.4, 0.004), (110.0, 14.0, 0.6, 0.006), 0.02) == pytest.approx(1 / 0.8)
+    assert energy_control((100.0, 10.0, -0.4, -0.004), (110.0, 14.0, -0.6, -0.006), 0.02) == pytest.approx(1 / 0.8)
+    # at or beyond 1 %: a tenth of the tolerance
+    assert energy_control((100.0, 10.0, 1.0, 0.01), (110.0, 14.0, 1.2, 0.012), 0.02) == pytest.approx(10.0)

@@ -59,7 +59,8 @@ def _path_settings(st: schema.Steps, model: Model):
                         arc_length_max=st.arc_length_max, dissipation=st.dissipation,
                         dissipation_threshold=st.dissipation_threshold, target_iterations=st.target_iterations,
                         max_steps=st.max_steps,
-                        max_cuts=max(st.max_bisections, 1), jump_area=st.jump_area, jump_ratio=st.jump_ratio)
+                        max_cuts=max(st.max_bisections, 1), jump_area=st.jump_area, jump_ratio=st.jump_ratio,
+                        energy_tolerance=st.energy_tolerance or None)
 
 
 @dataclass

@@ -43,6 +43,10 @@ from .newton import (RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSe
 from .problem import Problem
 
 
+#: default [steps] energy_tolerance (see :func:`increment_energy_error`)
+ENERGY_TOLERANCE = 0.02
+
+
 class PathError(ValueError):
     """A path-following setting that does not fit the model."""
 
@@ -74,6 +78,11 @@ class PathSettings:
     relax_after_cuts: int = RELAX_AFTER_CUTS
     jump_area: float | None = 0.2
     jump_ratio: float | None = 3.0
+    # an increment whose energy balance error exceeds this share of its energy (the larger of its
+    # external work and its dissipation, :func:`increment_energy_error`) is cut (at most
+    # ``max_energy_cuts`` times), and the next increment is shortened to aim below it; None: off
+    energy_tolerance: float | None = ENERGY_TOLERANCE
+    max_energy_cuts: int = 3
 
 
 @dataclass
@@ -131,6 +140,60 @@ def check_path(problem: Problem, ps: PathSettings) -> None:
         raise PathError("'steps.control' = 'arc_length' with a prescribed displacement that is scaled by λ "
                         "([[supports]] with 'value'): arc-length control scales forces only; use control = 'load' "
                         "for displacement control, or set scaled = false on that support")
+
+
+def balance_terms(problem: Problem, u: np.ndarray) -> tuple[float, float, float, float] | None:
+    """(external work W, energy dissipated D, balance error E = W − U − E_I − D, and E relative
+    to the run's energy as summary.json reports it) of the cohesive energy ledger at the committed
+    state ``u``; None without cohesive interfaces."""
+    energies = getattr(problem.interfaces, "energies", None)
+    e = energies(problem, u) if energies is not None else None
+    if e is None:
+        return None
+    D = e["dissipated_fracture"] + e["dissipated_friction"] + e["dissipated_viscous"]
+    return (e["external_work"], D, e["external_work"] - e["strain_energy"] - e["interface_elastic_energy"] - D,
+            e["balance_error"])
+
+
+#: an increment whose energy is below this share of the external work so far is not judged by
+#: :func:`increment_energy_error` (round-off of the ledger, not an error of the path)
+ENERGY_FLOOR = 1e-3
+#: the energy-error step control acts once the run's balance error exceeds this (half the 1 %
+#: at which the runner warns, runner.ENERGY_BALANCE_TOL)
+ENERGY_CONTROL_FROM = 0.005
+#: the run's balance error at which the runner warns (runner.ENERGY_BALANCE_TOL, issue 13)
+ENERGY_WARN = 0.01
+
+
+def increment_energy_error(b0: tuple | None, b1: tuple | None) -> float:
+    """The energy balance error an increment adds, |Δ(W − U − E_I − D)|, relative to its energy
+    max(|ΔW|, ΔD) (at least ENERGY_FLOOR × |W|): 0 exactly on a path that the ledger follows.
+    The trapezoidal work of the converged states and the interface ledger, which follows each
+    interface point along the straight separation path between them, disagree where a point's
+    path between two states is not straight (a mixed-mode front point that starts damaging in
+    shear and fails open within one increment: examples/mmb_cohesive.toml, 7-26 % of the
+    increment's energy on its default increments, always of one sign) or where a node row
+    releases within one increment (the force-loaded DCB: up to 2 %, of either sign, so that the
+    run's balance stays within 0.25 %). The error of an increment shrinks with its length, first
+    order relative to its energy, so that the step-size control can aim at a tolerance."""
+    if b0 is None or b1 is None:
+        return 0.0
+    dW, dD, de = b1[0] - b0[0], b1[1] - b0[1], b1[2] - b0[2]
+    return abs(de) / max(abs(dW), dD, ENERGY_FLOOR * abs(b1[0]), 1e-300)
+
+
+def energy_control(b0: tuple | None, b1: tuple | None, tolerance: float) -> float:
+    """How far an increment from the ledger terms ``b0`` to ``b1`` (:func:`balance_terms`) exceeds
+    the energy tolerance: its :func:`increment_energy_error` over the tolerance that applies (≤ 1
+    is within), where the step control should act on it: the run's balance error is above
+    ENERGY_CONTROL_FROM and this increment made it larger; else 0 (errors of either sign that
+    cancel, as the DCB's, cost no increments). The tolerance falls linearly from ``tolerance`` at
+    ENERGY_CONTROL_FROM to a tenth of it at the 1 % where the runner warns, so that the run's
+    balance error approaches that limit ever more slowly."""
+    if b0 is None or b1 is None or abs(b1[3]) <= ENERGY_CONTROL_FROM or abs(b1[2]) <= abs(b0[2]):
+        return 0.0
+    room = (ENERGY_WARN - abs(b1[3])) / (ENERGY_WARN - ENERGY_CONTROL_FROM)
+    return increment_energy_error(b0, b1) / (tolerance * min(1.0, max(0.1, room)))
 
 
 def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float,
@@ -484,9 +547,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         warns: list[str] = []
         size0 = st.size
         f_itf0 = interface_forces(problem, u)[0] if itf_form else None  # the start's (committed) state
+        b0 = (balance_terms(problem, u) if arc and ps.energy_tolerance is not None and on_step_end is not None
+              else None)  # the ledger at the start (energy_control)
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
+            e_rel = 0.0
             if st.mode == "load":
                 dlam = min(st.size, end - lam)
                 to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
@@ -541,10 +607,19 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
                                  scales, floors() if floors is not None else None):
                     ok, msg = False, "probe jump"
+            if ok and b0 is not None and st.mode != "load":  # under load (displacement) control a node row
+                # that releases within a step is a jump of the path, which shorter steps do not resolve
+                e_rel = energy_control(b0, balance_terms(problem, att.u), ps.energy_tolerance)
+                if e_rel > 1.0 and cuts < ps.max_energy_cuts:
+                    ok, msg = False, "energy balance"
             if ok:
                 break
             if snap is not None:
                 problem.restore(snap)
+            if msg == "energy balance":  # a converged increment too long for the ledger: shorter, same control
+                cuts += 1
+                st.size *= max(0.25, min(0.5, 0.8 / e_rel))
+                continue
             if st.mode == "dissipation" and msg.startswith("no dissipation"):
                 # elastic branch: back to the arc length, its direction by the work criterion -
                 # the previous direction (a snap-back: load and displacement falling while the
@@ -610,6 +685,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         fac = min(2.0, max(0.5, ps.target_iterations / its))
         if cuts:
             fac = min(fac, 1.0)  # no growth right after a cut
+        if e_rel > 0.5:
+            fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
         if st.mode == "load":
             st.size = min(max(st.size * fac, inc_min), inc_max)
         elif st.mode == "arc":
