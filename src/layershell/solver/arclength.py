@@ -37,7 +37,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import (RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks,
+from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks,
                      at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax,
                      stabilise, stagnates)
 from .problem import Problem
@@ -126,6 +126,8 @@ class Attempt:
     iterations: int
     residuals: list[float] = field(default_factory=list)
     message: str = ""
+    # the constrained iterations' iterate of the smallest residual: (residual, u, λ, Δu_r, Δλ)
+    best: tuple | None = None
 
 
 def check_path(problem: Problem, ps: PathSettings) -> None:
@@ -277,6 +279,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     blocks = _frozen_blocks(problem)
     loop = ActiveSetLoop(blocks, True)
     loop.freeze(u0)
+    refreeze = MAX_REFREEZE
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
@@ -316,9 +319,18 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             att.message = "the cohesive loading set cycles (no consistent set near this increment)"
             return _unfrozen(att, blocks, loop, problem)
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
+        att.best = None
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
                                                 s.stagnation_iterations if blocks else 0, f_itf0)
+        if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
+                and any(b.set_changed(att.best[1]) for b in blocks)):
+            # as newton(): the frozen problem has no solution near this increment (its path turns
+            # back before it), while the actual one goes on with other sets - freeze them again at
+            # the best iterate, where they no longer hold, and iterate on from there
+            refreeze -= 1
+            _, att.u, att.lam, dur, dlam = att.best
+            continue
         if not ok:
             return _unfrozen(att, blocks, loop, problem)
         if loop.consistent(att.u, (att.u, att.lam)):
@@ -369,6 +381,8 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
         rn = float(np.linalg.norm(r))
         att.residuals.append(rn)
         att.u, att.lam, att.iterations = u, lam, start + it
+        if np.isfinite(rn) and (att.best is None or rn < att.best[0]):
+            att.best = (rn, u, lam, dur.copy(), dlam)
         if not np.isfinite(rn):
             att.message = "residual is not finite"
             return dur, dlam, False
