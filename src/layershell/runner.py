@@ -218,14 +218,9 @@ def _relaxed(summary: dict, events: list[dict], energy: dict | None, step: int, 
     events.clear()
 
 
-#: |external work - stored - dissipated| / external work above which a run warns (issue 13: 1 %;
-#: the arc length's energy-error step control, [steps] energy_tolerance, acts from half of it)
-ENERGY_BALANCE_TOL = ENERGY_WARN
-
-
 def _balance(summary: dict, energy: dict, step: int, log) -> None:
     """Warn once (console, run.log, summary.json 'warnings') at the first step whose energy
-    balance error exceeds ENERGY_BALANCE_TOL after energy has been dissipated: the ledger's
+    balance error exceeds ENERGY_WARN after energy has been dissipated: the ledger's
     dissipation and the work no longer agree, most often because the increments are long where
     the crack front moves (the ledger integrates each point's damage along the straight
     separation path between converged states; examples/mmb_cohesive.toml: 3.3 % without the arc
@@ -233,13 +228,13 @@ def _balance(summary: dict, energy: dict, step: int, log) -> None:
     displacement control, whose node rows release within one Newton solve: 1.9 %)."""
     err = energy.get("balance_error", 0.0)
     lost = sum(energy.get(k, 0.0) for k in ("dissipated_fracture", "dissipated_friction", "dissipated_viscous"))
-    if not (abs(err) > ENERGY_BALANCE_TOL and lost > 0) or summary.get("energy_balance_warned"):
+    if not (abs(err) > ENERGY_WARN and lost > 0) or summary.get("energy_balance_warned"):
         return
     import warnings as _w
 
     summary["energy_balance_warned"] = step
     m = (f"step {step}: the energy balance is off by {err:.2%} of the external work (external work - stored energy "
-         f"- dissipated, summary.json 'energy'; more than {ENERGY_BALANCE_TOL:.0%}): the dissipation the interfaces "
+         f"- dissipated, summary.json 'energy'; more than {ENERGY_WARN:.0%}): the dissipation the interfaces "
          "book and the work done disagree. The increments are likely too long where the crack front moves: the "
          "ledger follows each interface point along a straight separation path between converged states, which a "
          "mixed-mode front point does not take, nor a node row that releases within one Newton solve. Shorten them "

@@ -37,8 +37,8 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult, active_set_blocks,
-                     at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax,
+from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
+                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax,
                      stabilise, stagnates)
 from .problem import Problem
 
@@ -161,9 +161,10 @@ def balance_terms(problem: Problem, u: np.ndarray) -> tuple[float, float, float,
 #: :func:`increment_energy_error` (round-off of the ledger, not an error of the path)
 ENERGY_FLOOR = 1e-3
 #: the energy-error step control acts once the run's balance error exceeds this (half the 1 %
-#: at which the runner warns, runner.ENERGY_BALANCE_TOL)
+#: at which the runner warns, ENERGY_WARN)
 ENERGY_CONTROL_FROM = 0.005
-#: the run's balance error at which the runner warns (runner.ENERGY_BALANCE_TOL, issue 13)
+#: |external work - stored - dissipated| / external work above which a run warns (runner._balance;
+#: issue 13: 1 %)
 ENERGY_WARN = 0.01
 
 
