@@ -38,8 +38,8 @@ import numpy as np
 
 from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
-                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far, newton, relax,
-                     stabilise, stagnates)
+                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
+                     early_blocks, early_refreeze, newton, relax, stabilise, stagnates)
 from .problem import Problem
 
 
@@ -128,6 +128,9 @@ class Attempt:
     message: str = ""
     # the constrained iterations' iterate of the smallest residual: (residual, u, λ, Δu_r, Δλ)
     best: tuple | None = None
+    # the last constrained iterations ended early, near their solution, where the frozen sets no
+    # longer held (EARLY_REFREEZE): not a converged state
+    early: bool = False
 
 
 def check_path(problem: Problem, ps: PathSettings) -> None:
@@ -320,10 +323,11 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             att.message = "the cohesive loading set cycles (no consistent set near this increment)"
             return _unfrozen(att, blocks, loop, problem)
         left = s.max_contact_iterations - att.iterations if blocks else s.max_iterations
-        att.best = None
+        att.best, att.early = None, False
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
-                                                s.stagnation_iterations if blocks else 0, f_itf0)
+                                                s.stagnation_iterations if blocks else 0, f_itf0,
+                                                early=early_blocks(problem, blocks))
         if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
                 and any(b.set_changed(att.best[1]) for b in blocks)):
             # as newton(): the frozen problem has no solution near this increment (its path turns
@@ -334,6 +338,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
             continue
         if not ok:
             return _unfrozen(att, blocks, loop, problem)
+        if att.early:
+            continue  # near the frozen problem's solution the sets changed: freeze them there
         if loop.consistent(att.u, (att.u, att.lam)):
             att.converged = True
             return _unfrozen(att, blocks, loop, problem)
@@ -358,7 +364,8 @@ def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, pro
 def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
                             max_iterations: int, stagnation: int = 0,
-                            f_itf0: np.ndarray | None = None) -> tuple[np.ndarray, float, bool]:
+                            f_itf0: np.ndarray | None = None, early: list | None = None
+                            ) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
     it converged. ``stagnation``: give up after that many iterations in a row without progress
@@ -389,6 +396,9 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             return dur, dlam, False
         scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
         if it > 0 and rn <= s.tol_residual * scale:
+            return dur, dlam, True
+        if it > 0 and early_refreeze(early, u, rn, s.tol_residual * scale):
+            att.early = True  # the sets changed near the frozen problem's solution
             return dur, dlam, True
         if it == max_iterations:
             break
