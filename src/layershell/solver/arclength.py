@@ -284,6 +284,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     loop = ActiveSetLoop(blocks, True)
     loop.freeze(u0)
     refreeze = MAX_REFREEZE
+    early = early_blocks(problem, blocks)  # the friction caps change at commits only
     q = op.reduce(problem.F_scaled)
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
@@ -327,7 +328,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
                                                 s.stagnation_iterations if blocks else 0, f_itf0,
-                                                early=early_blocks(problem, blocks))
+                                                early=early)
         if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
                 and any(b.set_changed(att.best[1]) for b in blocks)):
             # as newton(): the frozen problem has no solution near this increment (its path turns

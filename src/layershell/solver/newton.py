@@ -143,8 +143,20 @@ def early_refreeze(blocks: list | None, u: np.ndarray, rn: float, tol: float) ->
     accept it where it cycles (:class:`ActiveSetLoop`)."""
     if not blocks or not tol < rn <= EARLY_REFREEZE * tol:
         return False
-    return any(b.set_violation(u) > b.CONSISTENCY_TOL if hasattr(b, "set_violation") else b.set_changed(u)
-               for b in blocks)
+    return sets_violation(blocks, u) > min(getattr(b, "CONSISTENCY_TOL", 0.0) for b in blocks)
+
+
+def sets_violation(blocks: list, u: np.ndarray, measured: bool = True) -> float:
+    """How far the frozen sets of ``blocks`` are from holding at ``u``: the largest
+    ``set_violation`` (a fraction of the strength, cohesive blocks; with ``measured``), infinite
+    where a block without that measure has a changed set, 0 where every set holds."""
+    v = 0.0
+    for b in blocks:
+        if measured and hasattr(b, "set_violation"):
+            v = max(v, b.set_violation(u))
+        elif b.set_changed(u):
+            return float("inf")
+    return v
 
 
 def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tuple[np.ndarray, NewtonResult]:
@@ -208,6 +220,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     s_frozen = replace(s, line_search=False) if cohesive_only else s
     loop = ActiveSetLoop(blocks, cohesive_only)
     refreeze = MAX_REFREEZE
+    early = early_blocks(problem, blocks) if cohesive_only else None  # the friction caps change at commits only
     for _ in range(s.max_active_set_loops):
         if not loop.freeze(u):
             total.message = "the cohesive loading set cycles (no consistent set near this increment)"
@@ -218,7 +231,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
             break
         u_new, res = newton_fixed_set(problem, u, lam, replace(s_frozen, max_iterations=min(s.max_iterations, left)),
                                       stagnation=FROZEN_STAGNATION if cohesive_only and s.unstable == "relax" else 0,
-                                      early=early_blocks(problem, blocks) if cohesive_only else None)
+                                      early=early)
         total.iterations += res.iterations
         total.residuals += res.residuals
         left -= res.iterations
@@ -298,12 +311,7 @@ class ActiveSetLoop:
     def consistent(self, u: np.ndarray, state: object) -> bool:
         """Do the frozen sets hold at the converged ``u``? If not, ``state`` is remembered when
         its violation is the smallest so far."""
-        v = 0.0
-        for b in self.blocks:
-            if hasattr(b, "set_violation") and self.tol > 0:
-                v = max(v, b.set_violation(u))
-            elif b.set_changed(u):
-                v = float("inf")
+        v = sets_violation(self.blocks, u, self.tol > 0)
         if v == 0.0:
             return True
         if self.best is None or v < self.best[0]:
