@@ -8,13 +8,14 @@ tests/test_dcb.py (``displacement_controlled``).
     PYTHONPATH=src python benchmarks/dcb.py 300 --viscosity 1e-6   # with viscous regularisation
     PYTHONPATH=src python benchmarks/dcb.py 100 --relax    # unstable jumps relaxed ([steps] unstable)
     PYTHONPATH=src python benchmarks/dcb.py 200 --relax --element mitc   # the MITC9 element
+    PYTHONPATH=src python benchmarks/dcb.py 100 150 200 --arc-displacement  # the prescribed opening by arc length
     PYTHONPATH=src python benchmarks/dcb.py --arc 100 [600]  # force-loaded, arc length (max steps)
     PYTHONPATH=src python benchmarks/dcb.py --arc 200 2000 --target 16  # [steps] target_iterations = 16
 
 Printed per mesh: node spacing h, DOFs, steps, iterations, CPU and wall seconds, the peak load,
 the load at the opening δ = 8 mm (interpolated along the branch), the branch's range against
 beam theory at the compliance-inferred crack length, the dissipated energy against G_Ic b Δa and
-the energy balance. With three meshes the observed order of convergence of P(δ = 8 mm) and of
+the largest energy balance error along the path. With three meshes the observed order of convergence of P(δ = 8 mm) and of
 the peak, p = ln(|f₁ - f₂| / |f₂ - f₃|) / ln(h₁/h₂) for the spacing ratio of the first pair
 (exact for equal ratios; with unequal ones the formula of Roache (1998) with the two ratios is
 used), and the order at which the largest deviation of the branch from beam theory falls. The
@@ -38,16 +39,19 @@ LENGTH = 150.0
 OPENING = 8.0
 
 
-def displacement_controlled(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full"):
+def displacement_controlled(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full",
+                            arc: bool = False):
     """tests/test_dcb.py ``displacement_controlled`` with an optional viscous regularisation, the
-    relaxation of unstable jumps (``[steps] unstable = "relax"``) and another element."""
-    if viscosity <= 0 and not relax and element == "full":
+    relaxation of unstable jumps (``[steps] unstable = "relax"``), another element, or (``arc``)
+    the prescribed opening traced by arc length (``control = "arc_length"``: through the
+    snap-backs of the front's node-by-node growth, where the opening falls)."""
+    if viscosity <= 0 and not relax and element == "full" and not arc:
         return T.displacement_controlled(nx)
     from helpers import run_example
 
-    repl = {**T.DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}",
-            "factors = [0.01, 0.02, 0.05,": ('unstable = "relax"\n' if relax else "")
-            + "n = 100\nadaptive = true\nincrement_max = 0.02 #"}
+    steps = ('control = "arc_length"\nn = 100\nmax_steps = 3000 #' if arc else
+             ('unstable = "relax"\n' if relax else "") + "n = 100\nadaptive = true\nincrement_max = 0.02 #")
+    repl = {**T.DISPLACEMENT_CONTROL, "nx = 150": f"nx = {nx}", "factors = [0.01, 0.02, 0.05,": steps}
     if viscosity > 0:
         repl["tau_max = 30.0"] = f"tau_max = 30.0\nviscosity = {viscosity!r}"
     if element != "full":
@@ -57,9 +61,19 @@ def displacement_controlled(nx: int, viscosity: float = 0.0, relax: bool = False
     return (np.array([s["probes"]["P"] for s in steps]), np.array([T.opening(s) for s in steps]), r.summary)
 
 
-def measure(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full") -> dict:
+def load_at_opening(P: np.ndarray, d: np.ndarray, at: float) -> float:
+    """P at the opening ``at``, interpolated between the states of its last crossing by an opening
+    increment (the path by arc length falls back through snap-backs, so δ is not monotonic)."""
+    k = np.flatnonzero((d[:-1] <= at) & (d[1:] > at))
+    if not k.size:
+        return math.nan
+    i = int(k[-1])
+    return float(P[i] + (P[i + 1] - P[i]) * (at - d[i]) / (d[i + 1] - d[i]))
+
+
+def measure(nx: int, viscosity: float = 0.0, relax: bool = False, element: str = "full", arc: bool = False) -> dict:
     t0, c0 = time.perf_counter(), time.process_time()
-    P, d, summary = displacement_controlled(nx, viscosity, relax, element)
+    P, d, summary = displacement_controlled(nx, viscosity, relax, element, arc)
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     pk = int(np.argmax(P))
     ratio = P[pk + 1:] / T.cbt_load_at(P[pk + 1:], d[pk + 1:])
@@ -67,10 +81,13 @@ def measure(nx: int, viscosity: float = 0.0, relax: bool = False, element: str =
     e = summary["energy"]
     return {"nx": nx, "h": LENGTH / (2 * nx), "steps": len(P),
             "iterations": sum(s["iterations"] for s in summary["steps"]), "cpu": cpu, "wall": wall,
-            "P_max": float(P.max()), "P_8": float(np.interp(OPENING, d, P)),
+            "P_max": float(P.max()), "P_8": load_at_opening(P, d, OPENING),
             "branch": (float(ratio.min() - 1), float(ratio.max() - 1)) if ratio.size else (math.nan, math.nan),
             "dissipated": e["dissipated_fracture"] / (T.GIC * T.B * (a_end - T.A0)) - 1,
-            "balance": e["balance_error"], "converged": summary["converged"],
+            "balance": max((abs(s["energy"]["balance_error"]) for s in summary["steps"] if s.get("energy")),
+                           default=abs(e["balance_error"])), "converged": summary["converged"],
+            "falling": int(np.sum(np.diff([s["load_factor"] for s in summary["steps"]]) < 0)),
+            "median": float(np.median(ratio) - 1) if ratio.size else math.nan,
             "viscous": e.get("dissipated_viscous", 0.0) / max(e["dissipated_fracture"], 1e-300),
             "relaxed": len([e for e in summary.get("relaxations", [])
                             if e["debonded_fraction_after"] > e["debonded_fraction_before"]]),
@@ -136,12 +153,13 @@ def main(argv: list[str]) -> None:
               + ("complete" if m["converged"] else f"stopped: {m['message']}") + " |")
         return
     relax = "--relax" in argv
+    arc = "--arc-displacement" in argv
     element = "full"
     if "--element" in argv:
         i = argv.index("--element")
         element = argv[i + 1]
         argv = argv[:i] + argv[i + 2:]
-    argv = [a for a in argv if a != "--relax"]
+    argv = [a for a in argv if a not in ("--relax", "--arc-displacement")]
     viscosity = 0.0
     if "--viscosity" in argv:
         i = argv.index("--viscosity")
@@ -150,11 +168,11 @@ def main(argv: list[str]) -> None:
     meshes = [int(a) for a in argv] or [150, 200, 300]
     os.environ.setdefault("LAYERSHELL_THREADS", "1")
     print("| elements | h (mm) | steps | iterations | CPU (s) | wall (s) | P_max (N) | P(δ = 8 mm) (N) | "
-          "branch vs beam theory | dissipated vs G_Ic b Δa | energy balance | sets accepted (largest violation) |")
+          "branch vs beam theory | dissipated vs G_Ic b Δa | energy balance (largest) | sets accepted (largest violation) |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     for nx in meshes:
-        m = measure(nx, viscosity, relax, element)
+        m = measure(nx, viscosity, relax, element, arc)
         rows.append(m)
         lo, hi = m["branch"]
         print(f"| {nx} | {m['h']:.3g} | {m['steps']} | {m['iterations']} | {m['cpu']:.0f} | {m['wall']:.0f} | "
@@ -163,6 +181,7 @@ def main(argv: list[str]) -> None:
               + ("" if m["converged"] else " (stopped)")
               + (f", viscous {100 * m['viscous']:.2f} % of fracture" if viscosity > 0 or relax else "")
               + (f", {m['relaxed']} jumps relaxed" if relax else "")
+              + (f", λ falls in {m['falling']} increments, branch median {100 * m['median']:+.1f} %" if arc else "")
               + f" | {m['accepted']} ({m['violation']:.1e}) |", flush=True)
     if len(rows) == 3:
         h = [m["h"] for m in rows]

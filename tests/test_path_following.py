@@ -342,8 +342,9 @@ def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
 def test_arc_length_without_a_scaled_load_is_bad_input():
     from layershell.io.build import InputError
 
+    fixed_tip = DISP_TIP.format(w=1.0) + "scaled = false\n"  # neither a force nor a displacement scaled by λ
     with pytest.raises(InputError, match="steps.control"):
-        _spec(DISP_TIP.format(w=1.0), False, 4, ARC_STEPS)
+        _spec(fixed_tip, False, 4, ARC_STEPS)
     with pytest.raises(InputError, match="steps.factors"):
         _spec(FORCE_TIP.format(P=0.1), False, 4, ARC_STEPS + "\nfactors = [0.5, 1.0]")
 
@@ -525,3 +526,86 @@ def test_energy_error_of_an_increment_and_when_the_step_control_acts():
     assert energy_control((100.0, 10.0, -0.4, -0.004), (110.0, 14.0, -0.6, -0.006), 0.02) == pytest.approx(1 / 0.8)
     # at or beyond 1 %: a tenth of the tolerance
     assert energy_control((100.0, 10.0, 1.0, 0.01), (110.0, 14.0, 1.2, 0.012), 0.02) == pytest.approx(10.0)
+
+
+# ------------------------------------------------------------------ displacement control by arc length
+U_BAR = 0.02  # prescribed end displacement at λ = 1
+
+
+def _strip_displacement(df: float):
+    """The softening strip with its end x = L pulled by a prescribed displacement u_L = λ ū
+    (a [[supports]] 'fix' with 'value') instead of the end force."""
+    load = STRIP[STRIP.index("[[loads]]"):STRIP.index("[steps]")]
+    spec = build(parse(STRIP.replace(load, f'[[supports]]\ntype = "fix"\nwhere = "near(x, 10)"\n'
+                                           f'components = ["x"]\nvalue = [{U_BAR}]\n').format(steps="")))
+    pb = Problem.build(spec.model)
+    x = spec.model.mesh.nodes
+    end = np.flatnonzero(np.isclose(x[:, 0], 0.0))
+    end = end[np.argsort(x[end, 1])]
+    spring = SofteningSpring(pb.dm.layer_dofs[0][end, 0, 0], [1 / 6, 4 / 6, 1 / 6], df)
+    pb.assembler.add_blocks([spring])
+    tip = np.flatnonzero(np.isclose(x[:, 0], 10.0))
+    return spec, pb, spring, pb.dm.layer_dofs[0][tip, 0, 0]
+
+
+def test_displacement_control_by_arc_length_traces_the_snap_back():
+    """Arc length on a prescribed displacement (λ scales u_L = λ ū, the load vector of the bordered
+    system is Tᵀ(F̂ − K g)). The strip with the snap-back (δ_f = 0.006): past the peak
+    (u_L = c_e F_p + δ0 = 0.011, λ = 0.55) the equilibrium path needs u_L to fall while the spring
+    softens, to u_L = δ_f = 0.006 (λ = 0.3) where the force has vanished - no prescribed
+    displacement that only grows can follow it. Independent reference: the analytic path (the
+    reaction F at the pulled end equals the spring force F_s(δ), u_L = c_e F + δ), the total
+    dissipation ½ F_p δ_f of the dissipation constraint (here with the reaction's work terms
+    ½(R₀Δλ − λ₀ΔR)); after complete separation the path goes on elastically, by the arc length
+    again, to λ_end = 1 with no force."""
+    from layershell.solver.arclength import PathSettings, path_steps
+
+    df = 0.006
+    spec, pb, spring, tipdofs = _strip_displacement(df)
+    ps = PathSettings(control="arc_length", lambda_end=1.0, increment=0.05, max_steps=200)
+    pts = []
+    for st in path_steps(pb, spec.newton, ps, on_step_end=lambda p, u, lam: spring.commit(u)):
+        d = float(spring.w @ st.u[spring.dofs[0]])
+        F = float(pb.reactions(st.u, st.load_factor)[tipdofs].sum())
+        assert np.allclose(st.u[tipdofs], st.load_factor * U_BAR, rtol=0, atol=1e-15)  # prescribed
+        pts.append((st.load_factor, d, F, st.state.mode, st.dissipation, st.end))
+    lam = np.array([p[0] for p in pts])
+    d = np.array([p[1] for p in pts])
+    F = np.array([p[2] for p in pts])
+    for lam_k, d_k, F_k in zip(lam, d, F):  # on the analytic path
+        assert lam_k * U_BAR == pytest.approx(C_E * F_k + d_k, abs=1e-9)
+        law = K0 * d_k if d_k <= D0 * (1 + 1e-9) else max(FP * (df - d_k) / (df - D0), 0.0)
+        assert F_k == pytest.approx(law, abs=1e-7)
+    i = int(np.argmax(F))
+    assert F[i] == pytest.approx(FP, rel=1e-6) and lam[i] == pytest.approx((C_E * FP + D0) / U_BAR, rel=1e-6)
+    # the snap-back: λ (the prescribed displacement) falls to u_L = δ_f while the spring softens
+    j = i + int(np.argmin(lam[i:]))
+    assert lam[j] == pytest.approx(df / U_BAR, rel=1e-6) and np.all(np.diff(lam[i:j + 1]) < 0)
+    assert np.all(np.diff(d[i:]) >= -1e-12)  # the crack only opens
+    assert sum(p[4] for p in pts) == pytest.approx(0.5 * FP * df, rel=1e-6)
+    assert all(p[4] >= -1e-12 for p in pts)
+    assert "dissipation" in {p[3] for p in pts} and pts[-1][3] == "arc"
+    assert lam[-1] == 1.0 and pts[-1][5] == "lambda_end" and abs(F[-1]) <= 1e-8 * FP  # (the spring keeps 1e-9 F_p)
+
+
+@pytest.mark.parametrize("nonlinear", [False, True])
+def test_displacement_control_by_arc_length_matches_load_control(nonlinear):
+    """A stable path: the cantilever with its tip deflection prescribed, traced by arc length,
+    passes through the displacement-controlled (load control) solutions: each traced point solved
+    again by Newton at its λ stays where it is, and the path ends at λ_end with the
+    load-controlled answer."""
+    from layershell.solver.arclength import PathSettings, path_steps
+    from layershell.solver.newton import newton
+
+    ds = _spec(DISP_TIP.format(w=4.0 if nonlinear else 1.0), nonlinear, 4)
+    rd = run(ds)
+    assert rd.converged
+    pb = Problem.build(ds.model)
+    pts = list(path_steps(pb, ds.newton, PathSettings(control="arc_length", lambda_end=1.0, increment=0.25)))
+    assert pts[-1].load_factor == 1.0 and pts[-1].state.finished
+    assert np.allclose(pts[-1].u, rd.u, rtol=0, atol=1e-8 * abs(rd.u).max())
+    assert np.all(np.diff([p.load_factor for p in pts]) > 0)
+    for p in pts[:-1]:
+        u2, res = newton(Problem.build(ds.model), p.u, p.load_factor, ds.newton)
+        assert res.converged and res.iterations <= 1
+        assert np.allclose(u2, p.u, rtol=0, atol=1e-8 * abs(rd.u).max())

@@ -419,7 +419,8 @@ def test_mpi_stopped_run_keeps_its_converged_steps(mpi_python, tmp_path):
     assert "no convergence" in json.loads(str(res["info"]))["stopped"]
 
 @pytest.mark.slow
-@pytest.mark.parametrize("case", ["dcb_example", "dcb_propagation", "bisection", "adaptive", "arc_length"])
+@pytest.mark.parametrize("case", ["dcb_example", "dcb_propagation", "bisection", "adaptive", "arc_length",
+                                  "displacement_arc_length"])
 def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     """mpiexec -n 2. ``dcb_example``: examples/dcb_cohesive.toml (150 elements) under its force
     control up to λ = 0.62, the last of its steps before the peak (λ ≈ 0.624, where force
@@ -430,11 +431,14 @@ def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     iterations). ``adaptive``: the short DCB under displacement control with adaptive steps
     (serial ``path_steps``; the crack grows, 87 → 139 fully damaged points). ``arc_length``: the
     short DCB's first three arc-length increments (two right-hand sides per iteration, 52
-    iterations in the third). Every step's displacement and damage equal the serial run to 1e-8 (measured:
+    iterations in the third). ``displacement_arc_length``: the short DCB under displacement
+    control traced by arc length (λ scales the prescribed opening; its load column Tᵀ(F̂ − K g)
+    by a difference of the distributed internal forces; 8 increments to λ = 0.29). Every step's displacement and damage equal the serial run to 1e-8 (measured:
     DCB example 1.3e-9 (in the first, linear steps: the direct solvers' round-off on this
     ill-conditioned system - MUMPS here, PARDISO serially) / 4.5e-12; propagation 6e-11 /
     7e-15 (on steps of 0.05 to λ = 0.6: 492 → 563 fully damaged points); bisection 1e-11 / 4e-15;
-    adaptive 2e-13 / 1e-14; arc length 1e-12 / 6e-14, its load factors to 1e-12)."""
+    adaptive 2e-13 / 1e-14; arc length 1e-12 / 6e-14, its load factors to 1e-12; displacement by arc
+    length 3e-12 / 8e-14, load factors 5e-13)."""
     if case == "dcb_example":
         text = dcb_text([0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.55, 0.58, 0.6, 0.61, 0.62])
     elif case == "dcb_propagation":
@@ -444,13 +448,16 @@ def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     elif case == "adaptive":
         text = dcb_text([0.3], {**SMALL_DCB, **DISPLACEMENT_CONTROL}).replace(
             "factors = [0.3]", "n = 10\nadaptive = true\nlambda_end = 0.6\nmax_steps = 15")
+    elif case == "displacement_arc_length":
+        text = dcb_text([0.3], {**SMALL_DCB, **DISPLACEMENT_CONTROL}).replace(
+            "factors = [0.3]", 'control = "arc_length"\nn = 10\nlambda_end = 0.6\nmax_steps = 8')
     else:
         text = dcb_text([0.3], SMALL_DCB).replace("factors = [0.3]", 'control = "arc_length"\nn = 5\nlambda_end = 2.0\nmax_steps = 3')
     (tmp_path / "dcb.toml").write_text(text)
     _mpirun(mpi_python, 2, tmp_path / "dcb.toml", tmp_path / "c.npz", "--mode", "newton")
     ref = serial_cohesive_steps(text)
     growth = [np.max(b[2] - a[2]) for a, b in zip(ref, ref[1:])]
-    assert sum(g > 1e-3 for g in growth) >= (1 if case == "arc_length" else 3)  # steps with damage growth
+    assert sum(g > 1e-3 for g in growth) >= (1 if case.endswith("arc_length") else 3)  # steps with damage growth
     if case == "dcb_propagation":  # the crack has grown: more fully damaged points
         assert np.sum(ref[-1][2] >= 1 - 1e-9) > np.sum(ref[0][2] >= 1 - 1e-9) + 10
     diff = _compare_cohesive(ref, np.load(tmp_path / "c.npz"))

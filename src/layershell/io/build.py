@@ -45,14 +45,13 @@ def _path_settings(st: schema.Steps, model: Model):
                          "adaptive = true")
     if st.control == "arc_length":
         scaled = [ld for ld in (*model.surface_loads, *model.edge_loads, *model.nodal_loads) if ld.scaled]
-        if not scaled:
+        prescribed = [fx for fx in model.fixes if fx.value is not None and fx.scaled]
+        if not scaled and not prescribed:
             raise InputError("'steps.control': 'arc_length' scales the loads with the load factor λ, but the model "
-                             "has no load with scaled = true; add a scaled [[loads]] table, or use control = 'load' "
-                             "(for displacement control a [[supports]] type = 'fix' with 'value')")
-        if any(fx.value is not None and fx.scaled for fx in model.fixes):
-            raise InputError("'steps.control': 'arc_length' scales forces only, but a [[supports]] table prescribes "
-                             "a displacement scaled by λ ('value'); use control = 'load' for displacement control, "
-                             "or set scaled = false on that support")
+                             "has no load with scaled = true and no prescribed displacement scaled by λ; add a "
+                             "scaled [[loads]] table, or a [[supports]] type = 'fix' with 'value' (displacement "
+                             "control; arc length then follows the path through snap-backs of the prescribed "
+                             "displacement)")
     inc = st.lambda_end / st.n
     return PathSettings(control=st.control, lambda_end=st.lambda_end, increment=inc,
                         increment_max=st.increment_max, arc_length=st.arc_length, arc_length_min=st.arc_length_min,

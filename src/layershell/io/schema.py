@@ -401,7 +401,8 @@ class Steps(Strict):
         "law in pseudo-time at the fixed load, until it holds without viscosity), as a specimen snaps in a test; "
         "the energy the jump releases is booked as viscous dissipation, each jump is a warning and an entry of "
         "summary.json 'relaxations'; where the interfaces separate completely (a limit point) the run stops. "
-        "'stop' (default): the run stops at such a step")
+        "'stop' (default): the run stops at such a step. To trace the snap-back instead, use control = "
+        "'arc_length' (also with prescribed displacements)")
     solver: Literal["auto", "superlu", "pardiso"] = Field("auto", description=(
         "sparse linear solver; auto: PARDISO where installed, else SuperLU"))
     reuse_factorization: Literal["auto", "always", "never"] = Field(
@@ -415,6 +416,8 @@ class Steps(Strict):
         "displacements alike: displacement control is a [[supports]] 'fix' with 'value'); 'arc_length': λ is an "
         "unknown of every increment (Crisfield's cylindrical arc length, switching to the dissipation-based "
         "constraint once energy is dissipated), so the path may pass limit points and snap-backs (λ decreases); "
+        "λ scales the forces and the prescribed displacements alike, so a displacement-controlled test traced by "
+        "arc length passes the snap-backs where the prescribed displacement must fall while a crack grows; "
         "the first increment is lambda_end/n, the run ends at λ = lambda_end, when λ falls below 0.1 % of its "
         "peak (complete failure) or after max_steps increments; the steps are sized automatically")
     adaptive: bool = Field(

@@ -5,7 +5,8 @@
 * Arc-length control (Riks 1979; Crisfield 1981, "A fast incremental/iterative solution
   procedure that handles snap-through", Comput. Struct. 13): the load factor is an unknown and
   the increment satisfies ‖w ∘ Δu_r‖² + ψ² Δλ² ‖q‖² = Δl² (ψ = 0: cylindrical, ψ = 1:
-  spherical), q = Tᵀ F_scaled, with w the length of each DOF (:func:`arc_weights`: t^l for a
+  spherical), q = Tᵀ F_scaled (Tᵀ(F_scaled − K g) where λ scales prescribed displacements g:
+  displacement control by arc length, :func:`load_rate`), with w the length of each DOF (:func:`arc_weights`: t^l for a
   director coefficient u_l, so that Δl is a displacement). Each iteration solves
   K_r [a, b] = [r, q] with one factorisation (bordering by superposition, δu = a + δλ b); δλ is
   the root of the quadratic constraint closest to the previous increment (Crisfield). Predictor
@@ -38,7 +39,7 @@ import numpy as np
 
 from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
-                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
+                     _record_scale, active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
                      early_blocks, early_refreeze, newton, relax, stabilise, stagnates)
 from .problem import Problem
 
@@ -134,17 +135,67 @@ class Attempt:
 
 
 def check_path(problem: Problem, ps: PathSettings) -> None:
-    """Raise PathError where arc-length control cannot work on ``problem``."""
+    """Raise PathError where arc-length control cannot work on ``problem``: λ must scale a load,
+    forces (scaled [[loads]]) or prescribed displacements (a [[supports]] 'fix' with 'value')."""
     if ps.control != "arc_length":
         return
-    if not np.any(problem.F_scaled):
+    if not np.any(problem.F_scaled) and prescribed_direction(problem) is None:
         raise PathError("'steps.control' = 'arc_length' scales the loads with the load factor λ, but the model has "
-                        "no load with scaled = true (or its loads sum to zero); add a scaled [[loads]] table, or "
-                        "use control = 'load' (a prescribed displacement: [[supports]] type = 'fix' with 'value')")
-    if problem.op.g_scaled is not None:
-        raise PathError("'steps.control' = 'arc_length' with a prescribed displacement that is scaled by λ "
-                        "([[supports]] with 'value'): arc-length control scales forces only; use control = 'load' "
-                        "for displacement control, or set scaled = false on that support")
+                        "no load with scaled = true (or its loads sum to zero) and no prescribed displacement "
+                        "scaled by λ; add a scaled [[loads]] table or a [[supports]] type = 'fix' with 'value'")
+
+
+def prescribed_direction(problem: Problem) -> np.ndarray | None:
+    """g: the prescribed displacements per unit load factor (full space, u = T u_r + λ g + g_c),
+    None where λ scales forces only."""
+    g = getattr(getattr(problem, "op", None), "g_scaled", None)
+    return g if g is not None and np.any(g) else None
+
+
+#: the finite-difference step of :func:`stiffness_along`, relative to the displacements
+FD_STEP = 1e-7
+
+
+def stiffness_along(problem: Problem, u: np.ndarray, g: np.ndarray, f: np.ndarray | None = None) -> np.ndarray:
+    """K(u) g (full space): the change of the internal force f_int along the prescribed
+    displacements g, by a forward difference of step FD_STEP × max(|u|, |g|) / |g| (∞-norms).
+    Exact to round-off on a linear bulk (f_int = K u); within the frozen cohesive sets of an
+    active-set solve the interface law is smooth. It enters the Jacobian of the bordered system
+    only (the column ∂r/∂λ, :func:`load_rate`), not the residual that decides convergence.
+    ``f``: f_int(u) where known."""
+    asm = problem.assembler
+    if f is None:
+        f, _ = asm.evaluate(u, tangent=False)
+    gmax = float(np.abs(g).max())
+    h = FD_STEP * max(float(np.abs(u).max()), gmax) / gmax
+    f1, _ = asm.evaluate(u + h * g, tangent=False)
+    return (f1 - f) / h
+
+
+def load_rate(problem: Problem, u: np.ndarray, f: np.ndarray | None = None) -> np.ndarray:
+    """−∂r/∂λ in full space at ``u``, r = F_ext(λ) − f_int(u(λ)) along u = T u_r + λ g + g_c: the
+    scaled forces F̂, less K(u) g where λ scales prescribed displacements g (displacement control
+    by arc length; :func:`stiffness_along`). The bordered arc-length system solves
+    K_r [a, b] = [r, Tᵀ(F̂ − K g)] and steps u by T(a + δλ b) + δλ g."""
+    g = prescribed_direction(problem)
+    if g is None:
+        return problem.F_scaled
+    return problem.F_scaled - stiffness_along(problem, u, g, f)
+
+
+def conjugates(problem: Problem, u: np.ndarray, f: np.ndarray | None = None) -> tuple[float, float]:
+    """(v, R): the displacement work-conjugate to λ of the scaled forces, v = F̂ᵀu, and the force
+    work-conjugate to λ of the prescribed displacements, R = gᵀ f_int(u) (their reaction; 0
+    without). The external work rate is λ v̇ + R λ̇ (F̂ and g on different DOFs), and on a linear
+    bulk at equilibrium the stored energy is ½ λ (v + R) - the terms of the dissipation
+    constraint (:func:`dissipation_increment`). ``f``: f_int(u) where known."""
+    v = float(problem.F_scaled @ u)
+    g = prescribed_direction(problem)
+    if g is None:
+        return v, 0.0
+    if f is None:
+        f, _ = problem.assembler.evaluate(u, tangent=False)
+    return v, float(g @ f)
 
 
 def balance_terms(problem: Problem, u: np.ndarray) -> tuple[float, float, float, float] | None:
@@ -205,13 +256,20 @@ def energy_control(b0: tuple | None, b1: tuple | None, tolerance: float) -> floa
 def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float,
                           f_itf0: np.ndarray | None = None) -> float:
     """ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀): energy dissipated by secant-unloading damage in the increment
-    (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20)). With ``f_itf0`` (the interface
-    forces at u₀, :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀) instead."""
+    (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20)); where λ scales prescribed
+    displacements g, their reaction R = gᵀf_int adds ½(R₀ Δλ − λ₀ ΔR) (the same derivation with λ
+    as the displacement and R as the force: external work ½(R₀ + R₁)Δλ less the change of the
+    stored ½ λ R; :func:`conjugates`). With ``f_itf0`` (the interface forces at u₀,
+    :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀) instead."""
     if f_itf0 is not None:
         f1, _ = interface_forces(problem, u0 + du)
         return 0.5 * (float(f_itf0 @ (u0 + du)) - float(f1 @ u0))
     F = problem.F_scaled
-    return 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
+    dG = 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
+    if prescribed_direction(problem) is not None:
+        R0, R1 = conjugates(problem, u0)[1], conjugates(problem, u0 + du)[1]
+        dG += 0.5 * (R0 * dlam - lam0 * (R1 - R0))
+    return dG
 
 
 def interface_form(problem: Problem) -> bool:
@@ -285,7 +343,10 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     loop.freeze(u0)
     refreeze = MAX_REFREEZE
     early = early_blocks(problem, blocks)  # the friction caps change at commits only
-    q = op.reduce(problem.F_scaled)
+    g = prescribed_direction(problem)  # λ scales prescribed displacements (displacement control)
+    f0 = asm.evaluate(u0, tangent=False)[0] if g is not None else None
+    rate0 = load_rate(problem, u0, f0)  # F̂ - K g
+    q = op.reduce(rate0)
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
     att = Attempt(False, u0, lam0, 0)
@@ -295,7 +356,9 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     except linear.SingularSystemError as exc:
         att.message = f"singular tangent ({exc})"
         return _unfrozen(att, blocks)
-    dUt = op.expand(dut)
+    dUt = op.expand(dut)  # the full-space predictor per unit λ
+    if g is not None:
+        dUt = dUt + g
     if mode == "arc":
         wt = dut * arc_weights(problem)
         dlam = size / math.sqrt(float(wt @ wt) + ps.psi**2 * qq)
@@ -311,14 +374,20 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         dlam = size / (a1 - a2)
     else:
         F = problem.F_scaled
-        den = 0.5 * (lam0 * float(F @ dUt) - float(F @ u0))
-        if abs(den) <= 1e-6 * 0.5 * (abs(lam0 * float(F @ dUt)) + abs(float(F @ u0))):
+        terms = [lam0 * float(F @ dUt), -float(F @ u0)]
+        if g is not None:  # ½(R₀ Δλ − λ₀ ΔR), ΔR ≈ (K g)·Δu (dissipation_increment)
+            terms += [conjugates(problem, u0, f0)[1], -lam0 * float((F - rate0) @ dUt)]
+        den = 0.5 * sum(terms)
+        # (displacement control: an interface that has separated leaves no reaction and nothing to
+        # dissipate, and the predictor would move λ by more than its largest value so far)
+        if (abs(den) <= 1e-6 * 0.5 * sum(abs(x) for x in terms)
+                or (g is not None and abs(size) > lam_ref * abs(den))):
             att.message = "no dissipation in the predictor direction"
             return _unfrozen(att, blocks)
         dlam = size / den
     dur = dlam * dut
     if blocks:  # the sets where the predictor ends: the front points it overloads load from the start
-        loop.freeze(u0 + op.expand(dur))
+        loop.freeze(u0 + op.expand(dur) + (dlam * g if g is not None else 0.0))
     for k in range(s.max_active_set_loops if blocks else 1):
         if k > 0 and not loop.freeze(att.u):
             att.message = "the cohesive loading set cycles (no consistent set near this increment)"
@@ -372,10 +441,12 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     it converged. ``stagnation``: give up after that many iterations in a row without progress
     (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets)."""
     op, asm = problem.op, problem.assembler
-    q = op.reduce(problem.F_scaled)
+    g = prescribed_direction(problem)  # λ scales prescribed displacements: q = Tᵀ(F̂ − K g) per iteration
+    q = op.reduce(load_rate(problem, u0))
     qq = float(q @ q)
     nq = math.sqrt(qq)
     Fc_r = op.reduce(problem.F_const)
+    R0 = conjugates(problem, u0)[1] if g is not None else 0.0
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
     start = att.iterations
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
@@ -384,9 +455,12 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
+        if g is not None:
+            u = u + dlam * g
         _release_closed(asm, u)  # frozen opening points that the iterate closed
         f, _ = asm.evaluate(u, tangent=False)  # the tangent only where an iteration follows
-        r = op.reduce(problem.external(lam) - f)
+        Fext = problem.external(lam)
+        r = op.reduce(Fext - f)
         rn = float(np.linalg.norm(r))
         att.residuals.append(rn)
         att.u, att.lam, att.iterations = u, lam, start + it
@@ -396,7 +470,13 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             att.message = "residual is not finite"
             return dur, dlam, False
         scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
+        if g is not None:  # as newton_fixed_set under displacement control: the reactions set the scale
+            pres = op.prescribed
+            scale = max(float(np.linalg.norm(op.reduce(Fext))), float(np.linalg.norm(f[pres] - Fext[pres])),
+                        1e-3 * getattr(problem, "force_scale", 0.0), 1e-300)
         if it > 0 and rn <= s.tol_residual * scale:
+            if g is not None:
+                _record_scale(problem, scale)  # the floor of the residual's scale once the reactions vanish
             return dur, dlam, True
         if it > 0 and early_refreeze(early, u, rn, s.tol_residual * scale):
             att.early = True  # the sets changed near the frozen problem's solution
@@ -406,6 +486,10 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
         if stagnates(att.residuals[first:], stagnation):
             att.message = f"no progress in the last {stagnation} of {it} iterations (residual {rn:.3e})"
             return dur, dlam, False
+        rate = None
+        if g is not None:  # the column ∂r/∂λ at this iterate (after the checks: the last evaluation is at u)
+            rate = load_rate(problem, u, f)
+            q = op.reduce(rate)
         try:
             _, Kr = asm.evaluate_reduced(u, op, forces=False)
             ab = solver.solve(Kr, np.column_stack([r, q]))
@@ -441,24 +525,31 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             # interface form (interface_form): g = ½(f_I(u₀)·u − f_I(u)·u₀) − Δτ, linearised with
             # ∂g/∂u = ½(f_I(u₀) − K_I(u)ᵀu₀): g + c·(A + δλ B) = 0 for δu = A + δλ B
             fI, kv = interface_forces(problem, u, u0)
-            g = 0.5 * (float(f_itf0 @ u) - float(fI @ u0)) - size
+            gc = 0.5 * (float(f_itf0 @ u) - float(fI @ u0)) - size
             c = 0.5 * (f_itf0 - kv)
-            cA, cB = float(c @ op.expand(a)), float(c @ op.expand(b))
+            cA, cB = float(c @ op.expand(a)), float(c @ (op.expand(b) + (g if g is not None else 0.0)))
             if cB == 0.0:
                 att.message = "the dissipation constraint does not depend on λ here"
                 return dur, dlam, False
-            dl = -(g + cA) / cB
+            dl = -(gc + cA) / cB
         else:
             # ½ F̂ᵀ(λ₀ (Δu + a + δλ b) − (Δλ + δλ) u₀) = Δτ  (linear in δλ)
             F = problem.F_scaled
-            Fa, Fb = float(F @ op.expand(a)), float(F @ op.expand(b))
-            Fu0, Fdu = float(F @ u0), float(F @ op.expand(dur))
-            g = 0.5 * (lam0 * (Fdu + Fa) - dlam * Fu0) - size
+            A, B, dU = op.expand(a), op.expand(b), op.expand(dur)
+            if g is not None:
+                B, dU = B + g, dU + dlam * g
+            Fa, Fb = float(F @ A), float(F @ B)
+            Fu0, Fdu = float(F @ u0), float(F @ dU)
+            gc = 0.5 * (lam0 * (Fdu + Fa) - dlam * Fu0) - size
             dg = 0.5 * (lam0 * Fb - Fu0)
+            if g is not None:  # + ½(R₀ Δλ − λ₀ ΔR), R = gᵀf_int linearised with K g = F̂ − rate
+                kg = F - rate
+                gc += 0.5 * (R0 * dlam - lam0 * (float(g @ f) - R0)) - 0.5 * lam0 * float(kg @ A)
+                dg += 0.5 * (R0 - lam0 * float(kg @ B))
             if dg == 0.0:
                 att.message = "the dissipation constraint does not depend on λ here"
                 return dur, dlam, False
-            dl = -g / dg
+            dl = -gc / dg
         dur = dur + a + dl * b
         dlam += dl
     att.message = f"no convergence in {max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
@@ -564,6 +655,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     recent: list[float] = []  # λ of the last accepted increments (stalled(), crawling())
     recent_dG: list[float] = []  # and their |ΔG| (crawling())
     itf_form = interface_form(problem)  # the dissipation measured at the interfaces
+    # λ scales prescribed displacements: after complete separation the path goes on elastically
+    # (no reaction) to λ_end, under the arc length again (below)
+    displacement_path = arc and prescribed_direction(problem) is not None
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
@@ -623,6 +717,14 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
+            if ok and displacement_path and st.mode == "dissipation" and e0 is not None and on_step_end is not None:
+                # the constraint takes the stored energy to be the secant one; where the crack faces
+                # close (contact is stiffer than the secant) an elastic path meets it without damage
+                # - the prescribed opening of the DCB on 100 elements 'converged' from δ = 6.2 mm
+                # back to 0 in one increment. The interfaces' own ledger must book the dissipation
+                e1 = dissipation_so_far(problem)
+                if e1 is not None and (e1[0] + e1[1]) - (e0[0] + e0[1]) < CONSTRAINT_BOOKED * st.size:
+                    ok, msg = False, "the dissipation constraint was met by closure, not damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
@@ -717,14 +819,19 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size = min(max(st.size * fac, inc_min), inc_max)
         elif st.mode == "arc":
             st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
-            elastic = 0.5 * abs(att.lam * float(problem.F_scaled @ att.u))
-            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > 0:
+            elastic = 0.5 * abs(att.lam * sum(conjugates(problem, att.u)))
+            floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
+            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
         else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
             # down where this one was longer (else a short bond's peak lies inside one increment)
             dun = float(np.linalg.norm(du[problem.op.independent] * arc_weights(problem)))
             st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
             st.arc_length = max(min(dun, dl_max), dl_min)
+            if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
+                # nothing left to dissipate (the interface has separated, the reaction vanished):
+                # the prescribed displacement goes on elastically, by the arc length
+                st.mode, st.size = "arc", st.arc_length
         st.du_prev = du
         st.changed = resolves > 0
         u, lam = att.u, att.lam
@@ -769,6 +876,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 f"[steps] stabilize passes such a state; else refine the mesh at the debonding front",
                 lam, residuals[-1] if residuals else float("nan"))
 
+
+#: under displacement control by arc length, a dissipation-controlled increment that dissipated
+#: less than this share of the energy dissipated so far was elastic (the interface has separated
+#: completely): the arc length takes over again, and only an increment dissipating more switches
+#: back to the dissipation constraint
+ELASTIC_INCREMENT = 1e-6
+
+#: under displacement control by arc length, a dissipation-controlled increment whose interfaces
+#: booked less than this share of the prescribed dissipation Δτ is not accepted (closure)
+CONSTRAINT_BOOKED = 0.5
 
 #: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
 STALL_FRACTION = 0.05
@@ -847,11 +964,11 @@ def arc_weights(problem: Problem) -> np.ndarray:
 def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -> float:
     """A first Δτ: the elastic energy ½ λ F̂ᵀu times the relative size of the arc length."""
     un = float(np.linalg.norm(u[problem.op.independent] * arc_weights(problem)))
-    return 0.5 * abs(lam * float(problem.F_scaled @ u)) * min(1.0, dl / max(un, 1e-300)) * 0.5
+    return 0.5 * abs(lam * sum(conjugates(problem, u))) * min(1.0, dl / max(un, 1e-300)) * 0.5
 
 
 def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: PathSettings) -> float:
     """‖w ∘ δu_r‖ (:func:`arc_weights`) of the linear predictor for the load increment ``ps.increment``."""
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op, forces=False)
-    dut = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, problem.op.reduce(problem.F_scaled))
+    dut = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, problem.op.reduce(load_rate(problem, u)))
     return abs(ps.increment) * float(np.linalg.norm(dut * arc_weights(problem)))

@@ -744,8 +744,10 @@ def cohesive_hint(problem: Problem, s: NewtonSettings) -> str:
     if s.stabilize > 0 or s.unstable != "stop" or not getattr(problem.interfaces, "cohesive", lambda: False)():
         return ""
     return ("; a model with cohesive interfaces passes such a step (a snap-back where the crack front jumps) with "
-            "[steps] unstable = 'relax' (the damage snaps to the next equilibrium at that load, the energy released "
-            "reported) or stabilize = 0.02 (viscous regularisation from there on, its share reported)")
+            "[steps] control = 'arc_length' (λ becomes an unknown and may fall: the path through the snap-back is "
+            "traced, for prescribed displacements as for forces), unstable = 'relax' (the damage snaps to the "
+            "next equilibrium at that load, the energy released reported) or stabilize = 0.02 (viscous "
+            "regularisation from there on, its share reported)")
 
 
 def dissipation_so_far(problem: Problem) -> tuple[float, float] | None:
