@@ -203,8 +203,10 @@ class SofteningSpring:
         return False
 
 
-def _strip(df: float, steps: str = ""):
-    spec = build(parse(STRIP.format(steps=steps)))
+def _strip(df: float, steps: str = "", text: str = STRIP):
+    """The strip (``text``: its model file) with the softening spring at x = 0: spec, problem,
+    spring and the DOFs of the end x = L."""
+    spec = build(parse(text.format(steps=steps)))
     pb = Problem.build(spec.model)
     x = spec.model.mesh.nodes
     end = np.flatnonzero(np.isclose(x[:, 0], 0.0))
@@ -536,16 +538,8 @@ def _strip_displacement(df: float):
     """The softening strip with its end x = L pulled by a prescribed displacement u_L = λ ū
     (a [[supports]] 'fix' with 'value') instead of the end force."""
     load = STRIP[STRIP.index("[[loads]]"):STRIP.index("[steps]")]
-    spec = build(parse(STRIP.replace(load, f'[[supports]]\ntype = "fix"\nwhere = "near(x, 10)"\n'
-                                           f'components = ["x"]\nvalue = [{U_BAR}]\n').format(steps="")))
-    pb = Problem.build(spec.model)
-    x = spec.model.mesh.nodes
-    end = np.flatnonzero(np.isclose(x[:, 0], 0.0))
-    end = end[np.argsort(x[end, 1])]
-    spring = SofteningSpring(pb.dm.layer_dofs[0][end, 0, 0], [1 / 6, 4 / 6, 1 / 6], df)
-    pb.assembler.add_blocks([spring])
-    tip = np.flatnonzero(np.isclose(x[:, 0], 10.0))
-    return spec, pb, spring, pb.dm.layer_dofs[0][tip, 0, 0]
+    return _strip(df, text=STRIP.replace(load, f'[[supports]]\ntype = "fix"\nwhere = "near(x, 10)"\n'
+                                               f'components = ["x"]\nvalue = [{U_BAR}]\n'))
 
 
 def test_displacement_control_by_arc_length_traces_the_snap_back():
