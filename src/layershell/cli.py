@@ -188,9 +188,14 @@ def check(model: Path = typer.Argument(..., help="model file (TOML)")):
         _fail(f"{model}: the supports and layer bonds could not be set up ({type(exc).__name__}: {exc}); "
               "check 'supports' (set LAYERSHELL_TRACEBACK=1 to see where it failed)")
     m = spec.model
+    pf = spec.path_following
+    if pf is None:
+        steps = f"{len(spec.load_factors)} load step(s)"
+    else:  # the steps are sized as the run goes
+        steps = (f"{'arc length' if pf.control == 'arc_length' else 'adaptive load steps'} to λ = {pf.lambda_end:g} "
+                 f"(first increment {pf.increment:g}, at most {pf.max_steps} increments)")
     out.print(f"{model}: OK — {m.mesh.n_elements} elements, {m.mesh.n_nodes} nodes, {len(m.layers)} layer(s), "
-              f"{op.n_red} DOFs, {len(spec.load_factors)} load step(s), {len(spec.probes)} probe(s)",
-              soft_wrap=True)
+              f"{op.n_red} DOFs, {steps}, {len(spec.probes)} probe(s)", soft_wrap=True)
 
 
 @app.command()

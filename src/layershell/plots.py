@@ -8,6 +8,7 @@ the parent folder of ``path`` and releases its figure.
 from __future__ import annotations
 
 import math
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -51,10 +52,14 @@ def plot_xy(path, x: tuple[str, list[float]], y: tuple[str, list[float]], title:
     ax.plot(xv[:m], yv[:m], "o-", ms=3, lw=1.2)
     ax.set_xlabel(x[0])
     ax.set_ylabel(y[0])
-    ax.set_title(title)
+    ax.set_title("\n".join(textwrap.wrap(title, TITLE_WIDTH)) if title else "")  # a long title wraps, not clipped
     ax.grid(True, alpha=0.4)
     fig.tight_layout()
     return _save(fig, path)
+
+
+#: characters per line of a figure title (about the width of a 5-inch figure at its font size)
+TITLE_WIDTH = 55
 
 
 def _label(name: str, unit: str | None, units: str) -> str:
