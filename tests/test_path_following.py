@@ -603,3 +603,27 @@ def test_displacement_control_by_arc_length_matches_load_control(nonlinear):
         u2, res = newton(Problem.build(ds.model), p.u, p.load_factor, ds.newton)
         assert res.converged and res.iterations <= 1
         assert np.allclose(u2, p.u, rtol=0, atol=1e-8 * abs(rd.u).max())
+
+
+def test_displacement_control_by_arc_length_restart(tmp_path):
+    """A model-file run whose prescribed tip deflection is traced by arc length, interrupted after
+    step 2 and restarted from its checkpoint, ends with the same steps, iterations and
+    displacements as the uninterrupted run (the prescribed part of u follows λ, which the
+    checkpoint restores with the path state)."""
+    spec = _spec(DISP_TIP.format(w=4.0), True, 4, ARC_STEPS)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    assert full.converged and full.summary["path_end"] == "lambda_end"
+    lams = [s["load_factor"] for s in full.summary["steps"]]
+    assert lams[-1] == 1.0 and len(lams) >= 3
+
+    def stop(i, n, lam):
+        if i == 2:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted and len(part.summary["steps"]) == 2
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged
+    assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-12)
+    assert [s["iterations"] for s in again.summary["steps"]] == [s["iterations"] for s in full.summary["steps"]]
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
