@@ -438,7 +438,7 @@ def test_mpi_cohesive_equals_serial_slow(mpi_python, tmp_path, case):
     ill-conditioned system - MUMPS here, PARDISO serially) / 4.5e-12; propagation 6e-11 /
     7e-15 (on steps of 0.05 to λ = 0.6: 492 → 563 fully damaged points); bisection 1e-11 / 4e-15;
     adaptive 2e-13 / 1e-14; arc length 1e-12 / 6e-14, its load factors to 1e-12; displacement by arc
-    length 3e-12 / 8e-14, load factors 5e-13)."""
+    length 2e-12 / 5e-13, load factors 4e-13)."""
     if case == "dcb_example":
         text = dcb_text([0.01, 0.02, 0.05, 0.1, 0.2, 0.3, 0.4, 0.5, 0.55, 0.58, 0.6, 0.61, 0.62])
     elif case == "dcb_propagation":

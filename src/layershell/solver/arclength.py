@@ -254,20 +254,21 @@ def energy_control(b0: tuple | None, b1: tuple | None, tolerance: float) -> floa
 
 
 def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float,
-                          f_itf0: np.ndarray | None = None) -> float:
+                          f_itf0: np.ndarray | None = None, reactions: tuple[float, float] | None = None) -> float:
     """ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀): energy dissipated by secant-unloading damage in the increment
     (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20)); where λ scales prescribed
     displacements g, their reaction R = gᵀf_int adds ½(R₀ Δλ − λ₀ ΔR) (the same derivation with λ
     as the displacement and R as the force: external work ½(R₀ + R₁)Δλ less the change of the
-    stored ½ λ R; :func:`conjugates`). With ``f_itf0`` (the interface forces at u₀,
-    :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀) instead."""
+    stored ½ λ R; :func:`conjugates`; ``reactions``: (R₀, R₁) where known). With ``f_itf0`` (the
+    interface forces at u₀, :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀)
+    instead."""
     if f_itf0 is not None:
         f1, _ = interface_forces(problem, u0 + du)
         return 0.5 * (float(f_itf0 @ (u0 + du)) - float(f1 @ u0))
     F = problem.F_scaled
     dG = 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
     if prescribed_direction(problem) is not None:
-        R0, R1 = conjugates(problem, u0)[1], conjugates(problem, u0 + du)[1]
+        R0, R1 = reactions if reactions is not None else (conjugates(problem, u0)[1], conjugates(problem, u0 + du)[1])
         dG += 0.5 * (R0 * dlam - lam0 * (R1 - R0))
     return dG
 
@@ -347,6 +348,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     f0 = asm.evaluate(u0, tangent=False)[0] if g is not None else None
     rate0 = load_rate(problem, u0, f0)  # F̂ - K g
     q = op.reduce(rate0)
+    R0 = float(g @ f0) if g is not None else 0.0  # the reaction at u0 (conjugates)
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
     att = Attempt(False, u0, lam0, 0)
@@ -376,7 +378,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         F = problem.F_scaled
         terms = [lam0 * float(F @ dUt), -float(F @ u0)]
         if g is not None:  # ½(R₀ Δλ − λ₀ ΔR), ΔR ≈ (K g)·Δu (dissipation_increment)
-            terms += [conjugates(problem, u0, f0)[1], -lam0 * float((F - rate0) @ dUt)]
+            terms += [R0, -lam0 * float((F - rate0) @ dUt)]
         den = 0.5 * sum(terms)
         # (displacement control: an interface that has separated leaves no reaction and nothing to
         # dissipate, and the predictor would move λ by more than its largest value so far)
@@ -397,7 +399,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
                                                 s.stagnation_iterations if blocks else 0, f_itf0,
-                                                early=early)
+                                                early=early, at_start=(q, R0))
         if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
                 and any(b.set_changed(att.best[1]) for b in blocks)):
             # as newton(): the frozen problem has no solution near this increment (its path turns
@@ -434,19 +436,21 @@ def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, pro
 def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
                             max_iterations: int, stagnation: int = 0,
-                            f_itf0: np.ndarray | None = None, early: list | None = None
-                            ) -> tuple[np.ndarray, float, bool]:
+                            f_itf0: np.ndarray | None = None, early: list | None = None,
+                            at_start: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
     it converged. ``stagnation``: give up after that many iterations in a row without progress
-    (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets)."""
+    (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets). ``at_start``: the
+    reduced load column q and the reaction R at u0 where the caller has them (:func:`arc_attempt`)."""
     op, asm = problem.op, problem.assembler
     g = prescribed_direction(problem)  # λ scales prescribed displacements: q = Tᵀ(F̂ − K g) per iteration
-    q = op.reduce(load_rate(problem, u0))
+    if at_start is None:
+        at_start = (op.reduce(load_rate(problem, u0)), conjugates(problem, u0)[1] if g is not None else 0.0)
+    q, R0 = at_start
     qq = float(q @ q)
     nq = math.sqrt(qq)
     Fc_r = op.reduce(problem.F_const)
-    R0 = conjugates(problem, u0)[1] if g is not None else 0.0
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
     start = att.iterations
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
@@ -658,6 +662,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     # λ scales prescribed displacements: after complete separation the path goes on elastically
     # (no reaction) to λ_end, under the arc length again (below)
     displacement_path = arc and prescribed_direction(problem) is not None
+    reaction: float | None = None  # R = gᵀ f_int at the committed state (displacement paths; conjugates)
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         total_it, cuts, resolves = 0, 0, 0
@@ -804,7 +809,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # accepted increment
         du = att.u - u
         dlam = att.lam - lam
-        dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0)
+        conj = conjugates(problem, att.u) if displacement_path else None  # (v, R) at the new state
+        if displacement_path and reaction is None:
+            reaction = conjugates(problem, u)[1]  # R at the start (first increment, restart)
+        dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0,
+                                   None if conj is None else (reaction, conj[1]))
         st.dissipated += dG
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
@@ -822,7 +831,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size = min(max(st.size * fac, inc_min), inc_max)
         elif st.mode == "arc":
             st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
-            elastic = 0.5 * abs(att.lam * sum(conjugates(problem, att.u)))
+            elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
             floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
             if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
@@ -838,6 +847,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         st.du_prev = du
         st.changed = resolves > 0
         u, lam = att.u, att.lam
+        reaction = conj[1] if conj is not None else None
         st.lam_peak = max(st.lam_peak, abs(lam))
         if st.mode == "load":
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
