@@ -318,11 +318,9 @@ def test_arc_length_on_a_geometrically_nonlinear_cantilever_matches_load_control
 ARC_STEPS = 'control = "arc_length"\nmax_steps = 40'
 
 
-def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
-    """[steps] control = 'arc_length' through the runner; a run interrupted after step 2 and
-    restarted from its checkpoint (arc length, last increment, λ) ends with the same steps and
-    displacements as an uninterrupted run."""
-    spec = _spec(FORCE_TIP.format(P=0.15), True, 4, ARC_STEPS)
+def _restart_matches_uninterrupted(spec, tmp_path):
+    """Run ``spec`` through; run it again, interrupted after step 2, and restart it from its
+    checkpoint: the same load factors, iterations and displacements (returns the first run)."""
     full = run(spec, tmp_path / "full", write_vtu=False)
     assert full.converged
     lams = [s["load_factor"] for s in full.summary["steps"]]
@@ -339,6 +337,14 @@ def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
     assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-12)
     assert [s["iterations"] for s in again.summary["steps"]] == [s["iterations"] for s in full.summary["steps"]]
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
+    return full
+
+
+def test_arc_length_run_from_the_model_file_and_restart(tmp_path):
+    """[steps] control = 'arc_length' through the runner; a run interrupted after step 2 and
+    restarted from its checkpoint (arc length, last increment, λ) ends with the same steps and
+    displacements as an uninterrupted run."""
+    _restart_matches_uninterrupted(_spec(FORCE_TIP.format(P=0.15), True, 4, ARC_STEPS), tmp_path)
 
 
 def test_arc_length_without_a_scaled_load_is_bad_input():
@@ -610,20 +616,4 @@ def test_displacement_control_by_arc_length_restart(tmp_path):
     step 2 and restarted from its checkpoint, ends with the same steps, iterations and
     displacements as the uninterrupted run (the prescribed part of u follows λ, which the
     checkpoint restores with the path state)."""
-    spec = _spec(DISP_TIP.format(w=4.0), True, 4, ARC_STEPS)
-    full = run(spec, tmp_path / "full", write_vtu=False)
-    assert full.converged and full.summary["path_end"] == "lambda_end"
-    lams = [s["load_factor"] for s in full.summary["steps"]]
-    assert lams[-1] == 1.0 and len(lams) >= 3
-
-    def stop(i, n, lam):
-        if i == 2:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
-    assert part.interrupted and len(part.summary["steps"]) == 2
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
-    assert again.converged
-    assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-12)
-    assert [s["iterations"] for s in again.summary["steps"]] == [s["iterations"] for s in full.summary["steps"]]
-    assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
+    _restart_matches_uninterrupted(_spec(DISP_TIP.format(w=4.0), True, 4, ARC_STEPS), tmp_path)
