@@ -17,9 +17,11 @@
 * Dissipation-based control (Gutiérrez 2004, Int. J. Numer. Meth. Engng 59; Verhoosel,
   Remmers & Gutiérrez 2009, Int. J. Numer. Meth. Engng 77): for damage with secant unloading the
   energy dissipated in an increment from (u₀, λ₀) is ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀), linear in the
-  unknowns; the constraint ΔG = Δτ replaces the arc length once a converged increment
-  dissipated more than ``dissipation_threshold`` × the elastic energy ½ λ F̂ᵀu (Verhoosel's
-  switch); where an increment cannot dissipate (elastic unloading) it goes back to the arc length.
+  unknowns (where λ scales prescribed displacements g, plus ½(R₀ Δλ − λ₀ ΔR) with the reaction
+  R = gᵀ f_int, :func:`dissipation_increment`); the constraint ΔG = Δτ replaces the arc length
+  once a converged increment dissipated more than ``dissipation_threshold`` × the elastic energy
+  ½ λ (F̂ᵀu + R) (Verhoosel's switch); where an increment cannot dissipate (elastic unloading,
+  or a separated interface under prescribed displacements) it goes back to the arc length.
 
 After a converged increment ``on_step_end(problem, u, λ)`` may change the state (debonding,
 damage history); a True return re-solves the same increment (from the same start and with the
