@@ -41,8 +41,9 @@ import numpy as np
 
 from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
-                     _record_scale, active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
-                     early_blocks, early_refreeze, newton, relax, stabilise, stagnates)
+                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
+                     early_blocks, early_refreeze, newton, reaction_scale, record_scale, relax, stabilise,
+                     stagnates)
 from .problem import Problem
 
 
@@ -438,17 +439,16 @@ def _unfrozen(att: Attempt, blocks: list, loop: ActiveSetLoop | None = None, pro
 def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0: float, size: float, mode: str,
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
                             max_iterations: int, stagnation: int = 0,
-                            f_itf0: np.ndarray | None = None, early: list | None = None,
-                            at_start: tuple[np.ndarray, float] | None = None) -> tuple[np.ndarray, float, bool]:
+                            f_itf0: np.ndarray | None = None, early: list | None = None, *,
+                            at_start: tuple[np.ndarray, float]) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
     it converged. ``stagnation``: give up after that many iterations in a row without progress
     (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets). ``at_start``: the
-    reduced load column q and the reaction R at u0 where the caller has them (:func:`arc_attempt`)."""
+    reduced load column q and the reaction R (0 without prescribed displacements) at u0, as
+    :func:`arc_attempt` has them from the committed state."""
     op, asm = problem.op, problem.assembler
     g = prescribed_direction(problem)  # λ scales prescribed displacements: q = Tᵀ(F̂ − K g) per iteration
-    if at_start is None:
-        at_start = (op.reduce(load_rate(problem, u0)), conjugates(problem, u0)[1] if g is not None else 0.0)
     q, R0 = at_start
     qq = float(q @ q)
     nq = math.sqrt(qq)
@@ -477,12 +477,10 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             return dur, dlam, False
         scale = nq * max(abs(lam), 1e-2 * lam_ref, 1e-300) + float(np.linalg.norm(Fc_r))
         if g is not None:  # as newton_fixed_set under displacement control: the reactions set the scale
-            pres = op.prescribed
-            scale = max(float(np.linalg.norm(op.reduce(Fext))), float(np.linalg.norm(f[pres] - Fext[pres])),
-                        1e-3 * getattr(problem, "force_scale", 0.0), 1e-300)
+            scale = reaction_scale(problem, f, Fext, float(np.linalg.norm(op.reduce(Fext))))
         if it > 0 and rn <= s.tol_residual * scale:
             if g is not None:
-                _record_scale(problem, scale)  # the floor of the residual's scale once the reactions vanish
+                record_scale(problem, scale)  # the floor of the residual's scale once the reactions vanish
             return dur, dlam, True
         if it > 0 and early_refreeze(early, u, rn, s.tol_residual * scale):
             att.early = True  # the sets changed near the frozen problem's solution

@@ -415,17 +415,16 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         if rn < best[0]:
             best = (rn, u)
-        scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
         if pres is not None:
-            scale = max(ref, float(np.linalg.norm(f[pres] - Fext[pres])), 1e-300)
-        # floor: 10⁻³ of the largest force scale of the run (only acts where the forces have almost
-        # vanished, e.g. a cohesive interface separated completely under prescribed displacements)
-        scale = max(scale, 1e-3 * getattr(problem, "force_scale", 0.0))
+            scale = reaction_scale(problem, f, Fext, ref)
+        else:
+            scale = ref if ref > 0 else max(float(np.linalg.norm(op.reduce(f))), 1e-300)
+            scale = max(scale, 1e-3 * getattr(problem, "force_scale", 0.0))
         if monitor is not None:
             monitor(it, lam, rn, scale, en, u)
         if it > 0 and rn <= s.tol_residual * scale:
             res.converged, res.iterations = True, it
-            _record_scale(problem, scale)
+            record_scale(problem, scale)
             return u, res
         if it > 0 and early_refreeze(early, u, rn, s.tol_residual * scale):
             res.converged = res.early = True
@@ -459,7 +458,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
         if it > 0 and at_round_off_floor(res.residuals, scale, en, e0, dU, u, s, lambda: abs(float(f @ u))):
             res.converged, res.iterations = True, it  # round-off floor reached
             res.message = "converged at the round-off floor"
-            _record_scale(problem, scale)
+            record_scale(problem, scale)
             return u + dU, res
         f, _ = asm.evaluate(u + dU, tangent=False)
         if globalise and float(np.linalg.norm(op.reduce(Fext - f))) > rn:
@@ -490,7 +489,16 @@ def at_round_off_floor(residuals: list[float], scale: float, en: float, e0: floa
     return len(residuals) > 2 and rn > 0.5 * residuals[-2] and en <= s.tol_energy * work()
 
 
-def _record_scale(problem: Problem, scale: float) -> None:
+def reaction_scale(problem: Problem, f: np.ndarray, Fext: np.ndarray, ref: float) -> float:
+    """The scale of the residual under prescribed displacements: the larger of the reduced applied
+    loads ``ref`` and the reactions ‖f_int − F_ext‖ at the prescribed DOFs, with a floor of 10⁻³
+    of the largest force scale of the run so far (it acts only where the forces have almost
+    vanished, e.g. a cohesive interface separated completely; :func:`record_scale`)."""
+    pres = problem.op.prescribed
+    return max(ref, float(np.linalg.norm(f[pres] - Fext[pres])), 1e-3 * getattr(problem, "force_scale", 0.0), 1e-300)
+
+
+def record_scale(problem: Problem, scale: float) -> None:
     if hasattr(problem, "force_scale"):
         problem.force_scale = max(problem.force_scale, scale)
 
