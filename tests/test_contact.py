@@ -23,10 +23,11 @@ def _two_layer(nonlinear=True, curved=True):
                  nonlinear=nonlinear)
 
 
+@pytest.mark.parametrize("rule", ["gauss", "lobatto"])
 @pytest.mark.parametrize("friction", [False, True])
-def test_contact_tangent_matches_finite_differences(rng, friction):
+def test_contact_tangent_matches_finite_differences(rng, friction, rule):
     m = _two_layer()
-    m.interface_laws = {1: InterfaceLaw(1.0, 1.0, alpha_N=5e3)}
+    m.interface_laws = {1: InterfaceLaw(1.0, 1.0, alpha_N=5e3, rule=rule)}
     m.initially_debonded = {1: np.arange(m.mesh.n_nodes)}  # everything released
     pb = Problem.build(m)
     blk = pb.assembler.extra[0]

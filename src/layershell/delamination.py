@@ -18,7 +18,10 @@ class InterfaceLaw:
     softening friction (4.70)-(4.78) (``gT_mu = inf``: constant μ0 τ_Delam); mu_coulomb: Coulomb
     fallback (4.84); alpha_N: normal contact penalty (None: 100 E_3,max / H_min); alpha_T: stick
     penalty of the regularised friction (None: G_13/H of the thinner layer); open_gap: a gap larger than this counts as open
-    (no friction; None: 0.1 × the upper layer's thickness).
+    (no friction; None: 0.1 × the upper layer's thickness); rule: the face points of the contact
+    and friction between debonded layers, "gauss" (the thesis's (3.48)) or "lobatto" (the nodes:
+    no traction oscillation of the stiff penalty, whose contact set can cycle at the Gauss points
+    of refined meshes); the criterion (4.15) is evaluated at the Gauss points either way.
     """
 
     sigma_max: float
@@ -31,6 +34,7 @@ class InterfaceLaw:
     alpha_N: float | None = None
     alpha_T: float | None = None
     open_gap: float | None = None
+    rule: str = "gauss"
 
     def check(self, name: str = "interface") -> None:
         bad = []
@@ -48,6 +52,8 @@ class InterfaceLaw:
             bad.append(f"gT_mu = {self.gT_mu} must be positive (use inf for constant friction)")
         if not self.mu_coulomb >= 0:
             bad.append(f"mu_coulomb = {self.mu_coulomb} must not be negative")
+        if self.rule not in ("gauss", "lobatto"):
+            bad.append(f"rule = {self.rule!r}: use \"gauss\" (the thesis's face points) or \"lobatto\" (the nodes)")
         if self.open_gap is not None and not self.open_gap > 0:
             bad.append(f"open_gap = {self.open_gap} must be positive (leave it out for 0.1 × the layer thickness)")
         if bad:

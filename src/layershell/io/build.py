@@ -628,7 +628,8 @@ def _cohesive_law(idf, f: str, gT: float, model, upper: int, lower: int):
                          "area in the model's units, e.g. kN/m for kN, m): add them to the interface, e.g. from a "
                          "DCB (G_Ic) and an ENF or shear bond test (G_IIc)")
     law = CohesiveLaw(idf.G_Ic, idf.G_IIc, idf.sigma_max, idf.tau_max, idf.eta, idf.p, idf.onset, idf.softening,
-                      idf.K0, idf.alpha, idf.viscosity, idf.mu0, idf.mu, gT, idf.mu_coulomb, idf.alpha_T, idf.rule)
+                      idf.K0, idf.alpha, idf.viscosity, idf.mu0, idf.mu, gT, idf.mu_coulomb, idf.alpha_T,
+                      idf.rule or "lobatto")
     try:
         law.check(f)
     except ValueError as exc:
@@ -674,7 +675,7 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             law = _cohesive_law(idf, f, gT, model, k, below[k])
         else:
             law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
-                               idf.alpha_N, idf.alpha_T, idf.open_gap)
+                               idf.alpha_N, idf.alpha_T, idf.open_gap, idf.rule or "gauss")
             try:
                 law.check(f)
             except ValueError as exc:

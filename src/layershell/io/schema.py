@@ -377,12 +377,14 @@ class Steps(Strict):
         "Newton convergence: residual norm ≤ tolerance × norm of the applied load vector λF (relative, "
         "dimensionless)"))
     max_iterations: PositiveInt = Field(25, le=10_000, description=(
-        "Newton iterations per load increment before it is bisected"))
+        "Newton iterations per load increment before it is bisected (a re-solution at the same load after "
+        "new debonding, which cannot be bisected, gets 4 ×)"))
     max_bisections: int = Field(8, ge=0, le=30, description=(
         "halvings of a load increment that does not converge before the run stops"))
     max_contact_iterations: PositiveInt = Field(
         100, le=100_000, description="models with contact: Newton iterations per equilibrium solve in all "
-        "(semi-smooth and active-set loops) before the load increment is bisected")
+        "(semi-smooth and active-set loops) before the load increment is bisected (a re-solution at the same "
+        "load after new debonding: 4 ×)")
     stabilize: float = Field(
         0.0, ge=0, le=10, description="control = 'load' (fixed or adaptive steps) with cohesive interfaces: when "
         "a step fails through all its bisections (cuts), the viscous regularisation (interfaces' 'viscosity') is switched on from there with the "
@@ -619,9 +621,13 @@ class InterfaceDef(Strict):
         0.0, ge=0, description="cohesive: viscous regularisation time η in load-factor units (Gao & Bower 2004; 0 = "
                                "off): the damage follows the rate-independent one with ḋ = (d_inviscid - d)/η; its "
                                "extra dissipation is reported as dissipated_viscous")
-    rule: Literal["lobatto", "gauss"] = Field(
-        "lobatto", description="cohesive: interface integration at the nodes (Lobatto/Newton–Cotes, default) or at the "
-                               "3×3 Gauss points (tractions oscillate with stiff penalties, Schellekens & de Borst 1993)")
+    rule: Literal["lobatto", "gauss"] | None = Field(
+        None, description="interface integration at the nodes (\"lobatto\", Newton–Cotes) or at the 3×3 face Gauss "
+                          "points (\"gauss\"; tractions oscillate with stiff penalties, Schellekens & de Borst 1993). "
+                          "Cohesive law: the whole interface (default \"lobatto\"). Thesis law: the penalty contact and "
+                          "friction between debonded layers (default \"gauss\", the thesis's face points; \"lobatto\" "
+                          "lets refined meshes converge where the Gauss points' contact set cycles - the stress "
+                          "criterion stays at the Gauss points)")
 
 
 class DelaminationDef(Strict):

@@ -184,7 +184,7 @@ class InterfaceController:
                 runs.append(_cohesive_run(problem, itf, law, initial.get(itf.upper)))
                 continue
             alpha = law.alpha_N if law.alpha_N is not None else _default_penalty(model, itf)
-            blk = ContactBlock.build(model, dm, itf, alpha)
+            blk = ContactBlock.build(model, dm, itf, alpha, rule=law.rule)
             ne, nq = blk.w.shape
             if (settings or DelaminationSettings()).friction == "return_mapping":
                 blk.alpha_T = law.alpha_T if law.alpha_T is not None else _default_stick(model, itf)
@@ -239,6 +239,9 @@ class InterfaceController:
                 continue
             blk, itf = r.block, r.block.itf
             ne, nq = blk.w.shape
+            # the criterion's tractions at the face Gauss points (3.48); the contact block's point q
+            # (Gauss, or on the nodal rule the node itself) represents the region of the same node
+            # (contact.point_regions), so t[e, q] is its region's traction on either rule
             ps = interface_state(model, dm, u, itf, "gauss", self.settings.stresses, lam)
             t = ps.traction().reshape(ne, nq, 3)
             m = ps.m.reshape(ne, nq, 3, 3)
