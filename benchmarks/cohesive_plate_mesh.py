@@ -4,12 +4,16 @@ thesis's law) on the meshes given and prints first damage / first full debonding
 
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 6 12 24 [--thesis] [--beyond]
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 24 --element mitc --reuse never
+    PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 6 12 --only-thesis strong,weak,slip --rule lobatto
 
 ``--beyond``: load past the design load to λ = 1.2 (steps of 0.1 to 0.9, then 0.01), where the
 interface debonds completely at a first point (first_delamination_load_factor).
 ``--element mitc``: the MITC9 element instead of the example's; ``--reuse never|always``: the
 linear solver's ``[steps] reuse_factorization`` (default auto: GMRES on kept factorisations;
-the printed ``linear_solves`` count them).
+the printed ``linear_solves`` count them). ``--only-thesis CASES``: the thesis-law plates
+cantilever_plate_<case>.toml alone (strong, weak, slip); ``--rule lobatto|gauss``: their
+``[[interfaces]] rule`` (the contact between debonded layers at the nodes or at the face Gauss
+points, the default; docs/user-guide.md "Refined meshes with the thesis's law").
 """
 from __future__ import annotations
 
@@ -23,9 +27,12 @@ from layershell.runner import run
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
-def study(name: str, n: int, beyond: bool = False, element: str | None = None, reuse: str | None = None) -> dict:
+def study(name: str, n: int, beyond: bool = False, element: str | None = None, reuse: str | None = None,
+          rule: str | None = None) -> dict:
     path = EXAMPLES / f"{name}.toml"
     text = path.read_text()
+    if rule is not None:
+        text = text.replace("[[interfaces]]", f'[[interfaces]]\nrule = "{rule}"', 1)
     if element is not None:
         text = text.replace('element = "full"', f'element = "{element}"')
     for key in ("nx", "ny"):
@@ -45,18 +52,22 @@ def study(name: str, n: int, beyond: bool = False, element: str | None = None, r
             "cpu_s": round(time.process_time() - c0, 1),
             "iterations": sum(st["iterations"] for st in s["steps"]), "error": s.get("error"),
             "stabilized": s.get("stabilized"), "balance": (s.get("energy") or {}).get("balance_error"),
+            "debonded_area": (s.get("debonded_area") or [{}])[-1].get("concrete/trc"),
             "linear_solves": s.get("linear_solves")}
 
 
 def main(argv: list[str]) -> None:
     opts = {}
-    for flag in ("--element", "--reuse"):
+    for flag in ("--element", "--reuse", "--rule", "--only-thesis"):
         if flag in argv:
             i = argv.index(flag)
             opts[flag[2:]] = argv[i + 1]
             argv = argv[:i] + argv[i + 2:]
     meshes = [int(a) for a in argv if a.isdigit()] or [6, 12]
     names = ["cantilever_plate_cohesive"] + (["cantilever_plate_strong"] if "--thesis" in argv else [])
+    only = opts.pop("only-thesis", None)
+    if only is not None:
+        names = [f"cantilever_plate_{c}" for c in only.split(",")]
     for name in names:
         print(name)
         for n in meshes:
