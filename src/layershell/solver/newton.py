@@ -788,7 +788,7 @@ def contact_hint(problem: Problem) -> str:
 
     ctl = problem.interfaces
     if ctl is None or not any(isinstance(getattr(r, "law", None), InterfaceLaw) and r.law.rule == "gauss"
-                              for r in ctl.runs):
+                              for r in getattr(ctl, "runs", ())):
         return ""
     return ("; the contact between debonded layers acts at the face Gauss points (the thesis's), whose contact set can "
             "cycle on refined meshes: [[interfaces]] rule = \"lobatto\" puts it at the nodes (the stress criterion stays "
