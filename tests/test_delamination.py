@@ -440,3 +440,24 @@ def test_refined_thesis_plate_with_strong_friction_needs_the_budget_of_its_re_so
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
     step = run_example("cantilever_plate_strong", case)
     assert not step.converged and step.summary["steps"][-1]["load_factor"] == pytest.approx(0.5 - 1 / 24)
+
+
+def test_a_step_that_fails_after_complete_debonding_is_named_a_limit_point():
+    """newton.separated_hint: once every interface point has debonded (the pull-off refined to
+    18 × 16 releases its whole bond at λ = 0.3), a load step that finds no equilibrium is the
+    structure's limit point; the message says so instead of pointing at the contact rule."""
+    from types import SimpleNamespace
+
+    from layershell.solver.newton import separated_hint
+
+    def stand_in(fraction):
+        return SimpleNamespace(interfaces=SimpleNamespace(debonded_fraction=lambda: fraction))
+
+    assert "every interface point had debonded at load factor 0.3" in separated_hint(stand_in(1.0), 0.3)
+    assert separated_hint(stand_in(0.999), 0.3) == ""
+    assert separated_hint(SimpleNamespace(interfaces=None), 0.3) == ""
+    pb = _slip_plate()  # bonded at the start: nothing debonded
+    assert separated_hint(pb, 0.0) == ""
+    pb.bonded[1][:] = False
+    pb.interfaces.sync(pb)
+    assert "limit point" in separated_hint(pb, 1.0)

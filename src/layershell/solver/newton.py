@@ -629,7 +629,7 @@ def load_steps(
                 halved, bis, inc = s.max_bisections, 0, target - lam  # the step again, viscous from the converged state on
                 continue
             if bis > s.max_bisections:
-                hint = cohesive_hint(problem, s) + contact_hint(problem)
+                hint = separated_hint(problem, lam) or cohesive_hint(problem, s) + contact_hint(problem)
                 raise ConvergenceError(
                     f"step {n}: no convergence towards load factor {trial:.6g} after {s.max_bisections} "
                     f"bisections ({res.message}); the last converged load factor is {lam:.6g}{hint}",
@@ -774,6 +774,22 @@ def cohesive_hint(problem: Problem, s: NewtonSettings) -> str:
             "traced, for prescribed displacements as for forces), unstable = 'relax' (the damage snaps to the "
             "next equilibrium at that load, the energy released reported) or stabilize = 0.02 (viscous "
             "regularisation from there on, its share reported)")
+
+
+def separated_hint(problem: Problem, lam: float) -> str:
+    """The end of the message of a load step that failed after every interface point had
+    debonded (a thesis-law cascade through the whole bond, or a cohesive interface damaged
+    completely): the layers are then held by contact and friction alone, and a load beyond what
+    they carry has no equilibrium - the structure's limit point (the pull-off refined to 18 × 16
+    debonds its whole bond at λ = 0.3 and has no equilibrium at 0.300098), not a failure of the
+    solver. '' otherwise."""
+    fraction = getattr(problem.interfaces, "debonded_fraction", None)
+    if fraction is None or fraction() < 1.0 - 1e-9:
+        return ""
+    return (f"; every interface point had debonded at load factor {lam:.6g}: the layers are held by contact and "
+            "friction alone, and a larger load has no equilibrium (a limit point of the structure - the end of "
+            "the debonding, not a failure of the solver; arc length (control = 'arc_length') traces the path "
+            "past it where one exists)")
 
 
 def contact_hint(problem: Problem) -> str:
