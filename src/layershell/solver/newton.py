@@ -535,6 +535,12 @@ def reequilibration_settings(s: NewtonSettings) -> NewtonSettings:
                    max_active_set_loops=k * s.max_active_set_loops)
 
 
+def reequilibration_error(problem: Problem, n: int, lam: float, res: NewtonResult) -> ConvergenceError:
+    """The error of step ``n`` whose re-solution at ``lam`` after new releases failed."""
+    return ConvergenceError(f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}"
+                            + contact_hint(problem), lam, res.residuals[-1] if res.residuals else float("nan"))
+
+
 @dataclass
 class DebondCut:
     """Step cutting on large debonding jumps: if the re-solutions after one converged (sub)step
@@ -596,10 +602,7 @@ def load_steps(
                     if not res.converged:
                         if may_cut:
                             break
-                        raise ConvergenceError(
-                            f"step {n}: re-equilibration at load factor {trial:.6g} failed: {res.message}"
-                            + contact_hint(problem),
-                            trial, res.residuals[-1] if res.residuals else float("nan"))
+                        raise reequilibration_error(problem, n, trial, res)
                 if not res.converged:  # undo the increment and halve it
                     problem.restore(snap)
                     cuts += 1
@@ -641,10 +644,7 @@ def load_steps(
                 total_it += res.iterations
                 residuals += res.residuals
                 if not res.converged:
-                    raise ConvergenceError(
-                        f"step {n}: re-equilibration at load factor {lam:.6g} failed: {res.message}"
-                        + contact_hint(problem),
-                        lam, res.residuals[-1] if res.residuals else float("nan"))
+                    raise reequilibration_error(problem, n, lam, res)
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         prev_target = target
         yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0)
@@ -802,9 +802,8 @@ def contact_hint(problem: Problem) -> str:
     nodes; tests/test_delamination.py, docs/user-guide.md). '' otherwise."""
     from ..delamination import InterfaceLaw
 
-    ctl = problem.interfaces
-    if ctl is None or not any(isinstance(getattr(r, "law", None), InterfaceLaw) and r.law.rule == "gauss"
-                              for r in getattr(ctl, "runs", ())):
+    if not any(isinstance(getattr(r, "law", None), InterfaceLaw) and r.law.rule == "gauss"
+               for r in getattr(problem.interfaces, "runs", ())):
         return ""
     return ("; the contact between debonded layers acts at the face Gauss points (the thesis's), whose contact set can "
             "cycle on refined meshes: [[interfaces]] rule = \"lobatto\" puts it at the nodes (the stress criterion stays "
