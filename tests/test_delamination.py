@@ -11,6 +11,7 @@ from layershell.io.build import build, parse
 from layershell.material import Orthotropic
 from layershell.mesh import rectangle
 from layershell.model import Fix, Layer, Model, SurfaceLoad
+from layershell.solver.interface_state import contact_move_message
 from layershell.solver.newton import contact_hint, load_steps
 from layershell.solver.problem import Problem
 
@@ -294,17 +295,29 @@ def test_contact_iteration_cap_from_the_model_file(monkeypatch):
     """[steps] max_contact_iterations reaches the Newton settings: a cap of 8 makes the runner
     bisect the first increment of the §5.1 plate (14 iterations otherwise, no bisection). The
     re-equilibration after the first debonding cannot be bisected: it gets
-    REEQUILIBRATION_BUDGET (4) times the cap and converges; with the budget of a load step it
-    stops with a message that names the setting, and the converged step is kept."""
+    REEQUILIBRATION_BUDGET (4) times the cap and converges. With the budget of a load step and
+    the Gauss points asked for (rule = "gauss") it stops with a message that names the setting,
+    and the converged step is kept; with the rule left open the contact moves to the nodes there
+    (contact_to_nodes), the run reaches its end, and summary.json and a warning say where."""
+    from layershell.runner import ContactRuleWarning
     from layershell.solver import newton
 
     case = {"n = 24": "factors = [0.5, 0.6]\nmax_contact_iterations = 8"}
     budget = run_example("cantilever_plate_slip", case)
     assert budget.converged and budget.summary["steps"][0]["bisections"] >= 1
+    assert "contact_moved_to_nodes" not in budget.summary
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
-    capped = run_example("cantilever_plate_slip", case)
+    capped = run_example("cantilever_plate_slip", {**case, **GAUSS_CONTACT})
     assert not capped.converged and "max_contact_iterations" in capped.message
+    assert 'rule = "lobatto"' in capped.message
     assert capped.summary["steps"][0]["bisections"] >= 1
+    with pytest.warns(ContactRuleWarning, match="at load factor 0.6 the contact between debonded layers"):
+        moved = run_example("cantilever_plate_slip", case)
+    assert moved.converged and moved.summary["steps"][-1]["load_factor"] == 0.6
+    (move,) = moved.summary["contact_moved_to_nodes"]
+    assert move["step"] == 2 and move["load_factor"] == 0.6 and move["interfaces"] == ["trc"]
+    assert move["reason"].startswith("its re-solution after new releases: no equilibrium after 8 iterations")
+    assert any("acts at the nodes" in w for w in moved.summary["warnings"])
     plain = run_example("cantilever_plate_slip", {"n = 24": "factors = [0.5, 0.6]"})
     assert plain.converged and all(st["bisections"] == 0 for st in plain.summary["steps"])
 
@@ -398,7 +411,124 @@ def test_thesis_contact_rule_from_the_model_file_and_the_hint_of_a_failed_solve(
     assert contact_hint(_slip_plate("gauss", law="cohesive")) == ""
 
 
+def _debonded_state(pb: Problem, seed: int = 3) -> np.ndarray:
+    """Release the nodes of the §5.1 plate's clamped half (x ≤ 1.5) and give the released points
+    a friction state (slip limit, committed traction, stick anchor); returns a displacement u
+    (full space) at which some released points are closed and some open."""
+    rng = np.random.default_rng(seed)
+    nodes = np.flatnonzero(pb.model.mesh.nodes[:, 0] <= 1.5 + 1e-9)
+    pb.bonded[1][nodes] = False
+    pb.rebuild_constraints()
+    pb.interfaces.sync(pb)
+    blk = pb.interfaces.runs[0].block
+    rel = blk.released
+    assert rel.any() and not rel.all()
+    blk.cap = np.where(rel, 50.0 + 100.0 * rng.random(rel.shape), 0.0)
+    blk.t_n = np.where(rel[..., None], rng.normal(0, 20.0, rel.shape + (3,)), 0.0)
+    blk.g_p = np.where(rel[..., None], rng.normal(0, 1e-6, rel.shape + (3,)), 0.0)
+    return rng.normal(0.0, 1e-5, pb.dm.n_full)
+
+
+def test_thesis_contact_moves_from_the_gauss_points_to_the_nodes():
+    """InterfaceController.contact_to_nodes, which load_steps calls where the Gauss points'
+    contact set finds no equilibrium: the moved block is the nodal rule's (its points are the
+    region nodes), point q keeps its released flag, slip limit and committed traction, and its
+    trial friction traction α_T (P Δu - g_p) at the committed state is unchanged. The forces
+    the assembler then gives equal those of the same state built with rule = "lobatto" from the
+    start (an independent build), at the committed state and elsewhere; the move survives a
+    checkpoint (state/restore into a fresh Gauss-rule problem). Only a rule the model file left
+    open moves, and only once."""
+    pb = _slip_plate()
+    u = _debonded_state(pb)
+    old = pb.interfaces.runs[0].block
+    P = old.projector()
+    trial_old = old.alpha_T * (np.einsum("eqij,eqj->eqi", P, old.relative_displacement(u)) - old.g_p)
+    f_gauss, _ = pb.assembler.evaluate(u, tangent=False)
+    assert pb.interfaces.contact_to_nodes(pb, u, 0.375)
+    r = pb.interfaces.runs[0]
+    new = r.block
+    assert r.law.rule == "lobatto" and pb.extra_blocks == [new]
+    assert np.allclose(new.X0, pb.model.mesh.nodes[new.conn[:, new.region]])
+    assert np.array_equal(new.released, old.released)
+    assert np.array_equal(new.cap, old.cap) and np.array_equal(new.t_n, old.t_n)
+    trial_new = new.alpha_T * (np.einsum("eqij,eqj->eqi", new.projector(), new.relative_displacement(u)) - new.g_p)
+    rel = new.released
+    assert np.allclose(trial_new[rel], trial_old[rel], rtol=1e-12, atol=1e-9 * np.abs(trial_old).max())
+    assert pb.interfaces.contact_moves == [{"load_factor": 0.375, "interfaces": ["trc"], "reason": ""}]
+    assert "rule = \"lobatto\"" in contact_move_message(pb.interfaces.contact_moves[0])
+    assert "had moved from the face Gauss points to the nodes at load factor 0.375" in contact_hint(pb)
+    assert not pb.interfaces.contact_to_nodes(pb, u, 0.4)  # moved once
+
+    ref = _slip_plate("lobatto")
+    _debonded_state(ref)
+    for name in ("cap", "t_n", "g_p"):
+        setattr(ref.interfaces.runs[0].block, name, getattr(new, name).copy())
+    v = u + np.random.default_rng(5).normal(0.0, 1e-6, u.size)
+    for w in (u, v):
+        f_moved, _ = pb.assembler.evaluate(w, tangent=False)
+        f_ref, _ = ref.assembler.evaluate(w, tangent=False)
+        assert np.allclose(f_moved, f_ref, rtol=0, atol=1e-10 * np.abs(f_ref).max())
+    assert not np.allclose(f_moved, f_gauss, rtol=0, atol=1e-6 * np.abs(f_ref).max())  # the rule matters here
+
+    fresh = _slip_plate()  # a restart: the checkpoint's state moves a fresh Gauss-rule build
+    fresh.interfaces.restore(fresh, pb.interfaces.state(pb))
+    assert fresh.interfaces.runs[0].law.rule == "lobatto"
+    f_restart, _ = fresh.assembler.evaluate(v, tangent=False)
+    assert np.allclose(f_restart, f_moved, rtol=0, atol=1e-10 * np.abs(f_ref).max())
+
+    explicit = _slip_plate("gauss")  # asked for: stays at the Gauss points
+    _debonded_state(explicit)
+    assert not explicit.interfaces.contact_to_nodes(explicit, u, 0.375)
+    assert explicit.interfaces.runs[0].law.rule == "gauss"
+
+
+def test_contact_set_violation_is_the_traction_error_in_units_of_the_strength():
+    """ContactBlock.set_violation, by which a contact set that still changes after the allowed
+    active-set loops is accepted or not: 0 where the frozen set holds; α_N × the opening of a
+    point in the set, or the penetration of a released point outside it, over σ_max."""
+    pb = _slip_plate()
+    u = _debonded_state(pb)
+    blk = pb.interfaces.runs[0].block
+    blk.freeze(u)
+    assert blk.set_violation(u) == 0.0
+    g = blk.gap(u)
+    inside, outside = blk.active & blk.released, blk.released & ~blk.active
+    assert inside.any() and outside.any()
+    # the same state with the set flipped at one point each way
+    e, q = np.argwhere(inside)[np.argmin(g[inside])]
+    blk.active[e, q] = False  # a closed point (ḡ < 0) outside the set: a missing pressure
+    assert blk.set_violation(u) == pytest.approx(blk.alpha * -g[e, q] / 1980.0, rel=1e-12)
+    blk.active[e, q] = True
+    e, q = np.argwhere(outside)[np.argmax(g[outside])]
+    blk.active[e, q] = True  # an open point in the set: a spurious tension
+    assert blk.set_violation(u) == pytest.approx(blk.alpha * g[e, q] / 1980.0, rel=1e-12)
+    blk.strength = None
+    assert blk.set_violation(u) == np.inf
+
+
+def test_a_cycling_contact_set_is_not_accepted_with_interpenetration():
+    """examples/plate_gmsh.toml, whose Gauss-point contact set cycles at λ = 0.5 (re-solution):
+    before, a contact set still changing after the allowed active-set loops was accepted as it
+    was, and the run reported states with released points interpenetrating by up to 0.24 mm (λ
+    = 0.875) or pulled open in the set (λ = 0.5: a tension of 1.3 σ_max under α_N). Now such a
+    state is accepted only within CONTACT_SET_TOL of the strength: with rule = "gauss" the run
+    stops at λ = 0.5 naming the violation; with the rule left open the contact moves to the
+    nodes there and the run reaches λ = 1, every contact set holding where it converged."""
+    from layershell.solver.newton import CONTACT_SET_TOL
+
+    gauss = run_example("plate_gmsh", GAUSS_CONTACT)
+    assert not gauss.converged and gauss.summary["steps"][-1]["load_factor"] == 0.375
+    m = re.search(r"violates the contact condition by a traction of ([0-9.e+-]+) × the interface strength",
+                  gauss.message)
+    assert m and float(m.group(1)) > 100 * CONTACT_SET_TOL
+    moved = run_example("plate_gmsh")
+    assert moved.converged and moved.summary["steps"][-1]["load_factor"] == 1.0
+    assert [mv["load_factor"] for mv in moved.summary["contact_moved_to_nodes"]] == [0.5]
+    assert "active_set" not in moved.summary  # every contact set held exactly where it converged
+
+
 NODAL_CONTACT = {"[[interfaces]]": '[[interfaces]]\nrule = "lobatto"'}
+GAUSS_CONTACT = {"[[interfaces]]": '[[interfaces]]\nrule = "gauss"'}
 REFINED = {"nx = 3": "nx = 12", "ny = 3": "ny = 12"}
 
 
@@ -409,19 +539,27 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     with the contact at the face Gauss points the contact set of the re-solution after the first
     cascade cycles (a stiff penalty at Gauss points: its tractions oscillate from point to point,
     Schellekens & de Borst 1993) and the run stops at λ = 0.375 with a message that names the
-    setting; with the contact at the nodes it reaches λ = 1. The criterion stays at the Gauss
-    points: the first debonding (λ = 0.125 on 12 × 12; the thesis law's onset falls with the
-    mesh) is the same on both rules. (With the default budget the Gauss rule reaches λ = 1 too,
-    in 1884 iterations, measured: docs/user-guide.md.)"""
+    setting (rule = "gauss" asked for); with the contact at the nodes it reaches λ = 1. The
+    default (with the default budget, REEQUILIBRATION_BUDGET = 4) starts at the Gauss points,
+    moves to the nodes where a re-solution's contact set cycles (a set frozen for the third
+    time, at λ = 0.5; contact_to_nodes) and reaches λ = 1 with the nodal rule's deflection. The
+    criterion stays at the Gauss points: the first debonding (λ = 0.125 on 12 × 12; the thesis
+    law's onset falls with the mesh) is the same on every rule."""
     from layershell.solver import newton
 
+    moved = run_example("cantilever_plate_slip", REFINED)
+    assert moved.converged and moved.summary["steps"][-1]["load_factor"] == 1.0
+    (move,) = moved.summary["contact_moved_to_nodes"]
+    assert 0.125 < move["load_factor"] < 1.0 and "cycles" in move["reason"]
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
-    gauss = run_example("cantilever_plate_slip", REFINED)
+    gauss = run_example("cantilever_plate_slip", {**REFINED, **GAUSS_CONTACT})
     assert not gauss.converged and 'rule = "lobatto"' in gauss.message
     assert gauss.summary["steps"][-1]["load_factor"] == pytest.approx(0.375 - 1 / 24)
     nodal = run_example("cantilever_plate_slip", {**REFINED, **NODAL_CONTACT})
     assert nodal.converged and nodal.summary["steps"][-1]["load_factor"] == 1.0
-    for r in (gauss, nodal):
+    w = [r.summary["probes"]["w_front_max"] for r in (moved, nodal)]
+    assert w[0] == pytest.approx(w[1], rel=0.01)
+    for r in (gauss, nodal, moved):
         assert r.summary["first_delamination_load_factor"] == pytest.approx(0.125)
 
 

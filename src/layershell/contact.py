@@ -92,6 +92,8 @@ class ContactBlock:
     alpha: float
     released: np.ndarray
     active: np.ndarray | None = None  # frozen contact set during a Newton solve (None: from the gap)
+    # traction scale of set violations (the interface's tensile strength σ_max; None: not measured)
+    strength: float | None = None
     # penalty-regularised friction (return mapping): None = friction only as external loads
     alpha_T: float | None = None
     cap: np.ndarray | None = None  # (e, q) slip limit of the current step (0: no friction)
@@ -195,6 +197,20 @@ class ContactBlock:
 
     def unfreeze(self) -> None:
         self.active = None
+
+    def set_violation(self, u_full: np.ndarray) -> float:
+        """How far the frozen contact set is from holding at ``u_full``, as a traction error in
+        units of ``strength``: α_N times the largest opening of a point in the set (a spurious
+        tension) or penetration of a released point outside it (a missing pressure); 0 where the
+        set holds, infinite where it does not and no strength is known."""
+        if self.active is None or not self.released.any():
+            return 0.0
+        g = self.gap(u_full)
+        inside, outside = self.active & self.released, self.released & ~self.active
+        worst = max(float(g[inside].max()) if inside.any() else 0.0, float(-g[outside].min()) if outside.any() else 0.0)
+        if worst <= 0.0:
+            return 0.0
+        return self.alpha * worst / self.strength if self.strength else float("inf")
 
     def projector(self) -> np.ndarray:
         """P = I - A3 ⊗ A3: tangential part along the undeformed normal, (e, q, 3, 3)."""

@@ -21,7 +21,10 @@ class InterfaceLaw:
     (no friction; None: 0.1 × the upper layer's thickness); rule: the face points of the contact
     and friction between debonded layers, "gauss" (the thesis's (3.48)) or "lobatto" (the nodes:
     no traction oscillation of the stiff penalty, whose contact set can cycle at the Gauss points
-    of refined meshes); the criterion (4.15) is evaluated at the Gauss points either way.
+    of refined meshes); the criterion (4.15) is evaluated at the Gauss points either way;
+    rule_auto: the rule was not given in the model file - the contact starts at the Gauss points
+    and moves to the nodes where their contact set finds no equilibrium
+    (:meth:`~layershell.solver.interface_state.InterfaceController.contact_to_nodes`).
     """
 
     sigma_max: float
@@ -35,6 +38,7 @@ class InterfaceLaw:
     alpha_T: float | None = None
     open_gap: float | None = None
     rule: str = "gauss"
+    rule_auto: bool = False
 
     def check(self, name: str = "interface") -> None:
         bad = []

@@ -219,6 +219,23 @@ def _relaxed(summary: dict, events: list[dict], energy: dict | None, step: int, 
     events.clear()
 
 
+def _contact_moved(summary: dict, moves: list[dict], step: int, log) -> None:
+    """summary['contact_moved_to_nodes'] gets the moves of the thesis-law contact from the face
+    Gauss points to the nodes (InterfaceController.contact_to_nodes) made in this step, each a
+    warning; ``moves`` is emptied."""
+    import warnings as _w
+
+    from .solver.interface_state import contact_move_message
+
+    for mv in moves:
+        summary.setdefault("contact_moved_to_nodes", []).append({"step": step, **mv})
+        m = f"step {step}: " + contact_move_message(mv)
+        summary.setdefault("warnings", []).append(m)
+        _w.warn(m, ContactRuleWarning, stacklevel=2)
+        log(f"warning: {m}")
+    moves.clear()
+
+
 def _balance(summary: dict, energy: dict, step: int, log) -> None:
     """Warn once (console, run.log, summary.json 'warnings') at the first step whose energy
     balance error exceeds ENERGY_WARN after energy has been dissipated: the ledger's
@@ -319,6 +336,11 @@ class CohesiveWarning(UserWarning):
 
 class JumpWarning(UserWarning):
     """A step with a jump of the debonded area or of a probe."""
+
+
+class ContactRuleWarning(UserWarning):
+    """The thesis law's contact between debonded layers moved from the face Gauss points to the
+    nodes, where its contact set had found no equilibrium."""
 
 
 @dataclass
@@ -596,6 +618,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     _stabilized(summary, ctl.stabilized, energy, st.step, log)
                 if ctl is not None and getattr(ctl, "relaxations", None):  # unstable jumps relaxed (solver/newton.py relax)
                     _relaxed(summary, ctl.relaxations, energy, st.step, log)
+                if ctl is not None and getattr(ctl, "contact_moves", None):  # thesis contact moved to the nodes (solver/newton.py)
+                    _contact_moved(summary, ctl.contact_moves, st.step, log)
                 if getattr(problem, "accepted_sets", 0):  # cohesive active sets accepted within their tolerance (solver/newton.py)
                     summary["active_set"] = {"accepted_within_tolerance": problem.accepted_sets,
                                              "largest_violation": problem.accepted_violation}

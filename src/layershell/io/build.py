@@ -675,7 +675,8 @@ def _interfaces(mf: schema.ModelFile, model, index: dict, layers) -> None:
             law = _cohesive_law(idf, f, gT, model, k, below[k])
         else:
             law = InterfaceLaw(idf.sigma_max, idf.tau_max, idf.p, idf.mu0, idf.mu, gT, idf.mu_coulomb,
-                               idf.alpha_N, idf.alpha_T, idf.open_gap, idf.rule or "gauss")
+                               idf.alpha_N, idf.alpha_T, idf.open_gap, idf.rule or "gauss",
+                               rule_auto=idf.rule is None)
             try:
                 law.check(f)
             except ValueError as exc:

@@ -625,9 +625,11 @@ class InterfaceDef(Strict):
         None, description="interface integration at the nodes (\"lobatto\", Newton–Cotes) or at the 3×3 face Gauss "
                           "points (\"gauss\"; tractions oscillate with stiff penalties, Schellekens & de Borst 1993). "
                           "Cohesive law: the whole interface (default \"lobatto\"). Thesis law: the penalty contact and "
-                          "friction between debonded layers (default \"gauss\", the thesis's face points; \"lobatto\" "
-                          "lets refined meshes converge where the Gauss points' contact set cycles - the stress "
-                          "criterion stays at the Gauss points)")
+                          "friction between debonded layers (the stress criterion stays at the Gauss points). Left "
+                          "out, the contact starts at the thesis's face Gauss points and moves to the nodes, with a "
+                          "warning, where a solve finds no equilibrium there (on refined meshes the Gauss points' "
+                          "contact set can cycle); \"gauss\" keeps the Gauss points (the run then stops), "
+                          "\"lobatto\" uses the nodes from the start")
 
 
 class DelaminationDef(Strict):

@@ -166,6 +166,10 @@ class InterfaceController:
     # relax): one dict per event, and the runs whose viscous law a relaxation has switched on
     relaxations: list = field(default_factory=list)
     relaxing: list = field(default_factory=list, repr=False)
+    # thesis-law contact moved from the face Gauss points to the nodes where its contact set found no
+    # equilibrium (contact_to_nodes): one dict per move {load_factor, interfaces}
+    contact_moves: list = field(default_factory=list)
+    contact_moved_at: float | None = None  # the load factor of the last move (error messages)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
     f_last: np.ndarray | None = None  # [external force, layers' internal force] there
@@ -185,6 +189,7 @@ class InterfaceController:
                 continue
             alpha = law.alpha_N if law.alpha_N is not None else _default_penalty(model, itf)
             blk = ContactBlock.build(model, dm, itf, alpha, rule=law.rule)
+            blk.strength = law.sigma_max  # the scale of its set violations (solver/newton.py)
             ne, nq = blk.w.shape
             if (settings or DelaminationSettings()).friction == "return_mapping":
                 blk.alpha_T = law.alpha_T if law.alpha_T is not None else _default_stick(model, itf)
@@ -331,6 +336,59 @@ class InterfaceController:
                                "the debonding does not stabilise (unstable delamination)")
         return new_any and self.settings.reequilibrate
 
+    # ------------------------------------------------------------------ contact rule
+    def contact_to_nodes(self, problem, u: np.ndarray, lam: float, reason: str = "") -> bool:
+        """Move the penalty contact and friction between debonded layers of every thesis-law
+        interface whose rule the model file left open (``InterfaceLaw.rule_auto``) from the face
+        Gauss points to the nodes (rule "lobatto") - what ``load_steps`` does where a solve at
+        the Gauss points finds no equilibrium. There the stiff penalty's contact set can cycle on
+        refined meshes (the §5.1 plate with weak friction on 12 × 12: at λ = 0.75 the set went
+        round through 23, 21, 21, 22 and 23 points, the leaving points open by 10⁻⁸ m - a
+        tension of 3.4 MPa under α_N - and the entering ones closed by 2·10⁻⁶ m), while at the
+        nodes, where each point sees only its own node, it settles.
+
+        Point q of either rule represents the region of the same node (contact.point_regions),
+        so the released flags, the history of the points (g_T^max, friction loads) and the
+        friction state carry over point by point; the stick anchors g_p are shifted so that each
+        point keeps its trial traction α_T (P Δu - g_p) at ``u``, the state of the interfaces'
+        last commit; ``reason``: why the solve failed (recorded). The stress criterion (4.15)
+        stays at the Gauss points. True where something
+        moved (the assembler's pattern is then rebuilt; the move is recorded in
+        ``contact_moves``, which the runner reports with :func:`contact_move_message`)."""
+        moved = []
+        for r in self.runs:
+            if isinstance(r, CohesiveRun) or r.law.rule != "gauss" or not r.law.rule_auto:
+                continue
+            old = r.block
+            new = self._set_rule(problem, r, "lobatto")
+            if old.alpha_T is not None:
+                gT_old = np.einsum("eqij,eqj->eqi", old.projector(), old.relative_displacement(u))
+                gT_new = np.einsum("eqij,eqj->eqi", new.projector(), new.relative_displacement(u))
+                new.g_p = np.where(new.released[..., None], gT_new - (gT_old - old.g_p), new.g_p)
+            moved.append(problem.model.layers[old.itf.upper].name)
+        if not moved:
+            return False
+        problem.assembler.add_blocks(problem.extra_blocks)
+        self.sync(problem)
+        self.contact_moves.append({"load_factor": float(lam), "interfaces": moved, "reason": reason})
+        self.contact_moved_at = float(lam)
+        return True
+
+    def _set_rule(self, problem, r: InterfaceRun, rule: str) -> ContactBlock:
+        """Rebuild the contact block of the thesis-law run ``r`` on the face points of ``rule``,
+        with the released flags, the penalties and the friction state (slip limit, committed
+        traction, anchor) of the old block point by point; ``problem.extra_blocks`` then holds
+        it (the caller rebuilds the assembler's pattern)."""
+        old = r.block
+        new = ContactBlock.build(problem.model, problem.dm, old.itf, old.alpha, rule=rule)
+        new.released, new.strength = old.released.copy(), old.strength
+        if old.alpha_T is not None:
+            new.alpha_T = old.alpha_T
+            new.cap, new.t_n, new.g_p = old.cap.copy(), old.t_n.copy(), old.g_p.copy()
+        r.block, r.law, r.law_initial = new, replace(r.law, rule=rule), replace(r.law_initial, rule=rule)
+        problem.extra_blocks = [q.block for q in self.runs]
+        return new
+
     # ------------------------------------------------------------------ restart
     #: the friction state of a contact block (the history of an :class:`InterfaceRun` is every
     #: array field of it: initial, gmax, tau, fresh, V, gap, slip, pressure)
@@ -357,6 +415,8 @@ class InterfaceController:
                 value = getattr(_kin(r.block), name)
                 if value is not None:
                     out[f"run{i}.block.{name}"] = np.array(value, copy=True)
+            if isinstance(r, InterfaceRun):  # the contact's face points (contact_to_nodes may have moved them)
+                out[f"run{i}.nodal_contact"] = np.array(r.law.rule == "lobatto")
             if isinstance(r, CohesiveRun):
                 out[f"run{i}.block.d_old"] = np.array(r.block.d_old, copy=True)
                 out[f"run{i}.block.dv_old"] = np.array(r.block.dv_old, copy=True)
@@ -392,6 +452,16 @@ class InterfaceController:
         for k in problem.bonded:
             problem.bonded[k] = take(f"bonded.{k}", problem.bonded[k])
         self.lam = float(take("lam", None))
+        moved = False
+        for i, r in enumerate(self.runs):
+            key = f"run{i}.nodal_contact"
+            if isinstance(r, InterfaceRun) and key in state:  # (absent in checkpoints before contact_to_nodes)
+                rule = "lobatto" if bool(state[key]) else "gauss"
+                if rule != r.law.rule:
+                    self._set_rule(problem, r, rule)
+                    moved = True
+        if moved:
+            problem.assembler.add_blocks(problem.extra_blocks)
         for i, r in enumerate(self.runs):
             for name in self._run_arrays(r):
                 setattr(r, name, take(f"run{i}.{name}", getattr(r, name)))
@@ -561,6 +631,15 @@ class InterfaceController:
         return {"external_work": W, "strain_energy": U, "interface_elastic_energy": E_itf,
                 "dissipated_fracture": frac, "dissipated_friction": fric, "dissipated_viscous": visc,
                 "balance_error": err / max(abs(W), U + E_itf + frac + fric + visc, 1e-300)}
+
+
+def contact_move_message(move: dict) -> str:
+    """The warning for one move of :meth:`InterfaceController.contact_to_nodes`."""
+    return (f"at load factor {move['load_factor']:.6g} the contact between debonded layers at the face Gauss points "
+            f"(the thesis's points; below {', '.join(repr(m) for m in move['interfaces'])}) found no equilibrium"
+            + (f" ({move['reason']})" if move.get("reason") else "") + "; from there on it acts at the nodes, as with [[interfaces]] rule = \"lobatto\" (the "
+            "stress criterion stays at the Gauss points; summary.json 'contact_moved_to_nodes'). Set rule = \"gauss\" "
+            "to keep the Gauss points (the run then stops there) or rule = \"lobatto\" to use the nodes from the start")
 
 
 def _kin(block):
