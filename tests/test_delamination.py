@@ -482,6 +482,39 @@ def test_thesis_contact_moves_from_the_gauss_points_to_the_nodes():
     assert explicit.interfaces.runs[0].law.rule == "gauss"
 
 
+def test_adaptive_steps_move_the_contact_to_the_nodes_too():
+    """Adaptive load control (arclength.path_steps) moves the thesis's contact as load_steps
+    does: the §5.1 plate with max_contact_iterations = 8, whose re-solution after a cascade
+    fails at the Gauss points, reaches λ = 1 with the contact at the nodes; with rule = "gauss"
+    the run stops there with the message that names the setting."""
+    case = {"n = 24": "n = 24\nadaptive = true\nmax_contact_iterations = 8"}
+    moved = run_example("cantilever_plate_slip", case)
+    assert moved.converged and moved.summary["path_end"] == "lambda_end"
+    assert moved.summary["steps"][-1]["load_factor"] == 1.0
+    (move,) = moved.summary["contact_moved_to_nodes"]
+    assert 0.5 < move["load_factor"] < 1.0 and "max_contact_iterations" in move["reason"]
+    kept = run_example("cantilever_plate_slip", {**case, **GAUSS_CONTACT})
+    assert not kept.converged and 'rule = "lobatto"' in kept.message
+    assert "contact_moved_to_nodes" not in kept.summary
+
+
+def test_a_path_that_ends_at_max_steps_before_lambda_end_is_warned():
+    """The Gmsh plate with adaptive steps crawls near λ = 0.496 (each tiny increment still takes
+    7-9 Newton iterations, so the step-size control never grows it): a run that stops at
+    [steps] max_steps before lambda_end is converged (every increment an equilibrium) but says
+    that the load asked for was not reached; one that reaches lambda_end does not."""
+    from layershell.runner import JumpWarning
+
+    with pytest.warns(JumpWarning, match="the path ended after \\[steps\\] max_steps = 20 increments"):
+        r = run_example("plate_gmsh", {"[steps]\nn = 8": "[steps]\nn = 8\nadaptive = true\nmax_steps = 20"})
+    assert r.converged and r.summary["path_end"] == "max_steps"
+    assert r.summary["steps"][-1]["load_factor"] < 0.5
+    assert any("before lambda_end = 1" in w for w in r.summary["warnings"])
+    full = run_example("cantilever_plate_slip", {"n = 24": "n = 24\nadaptive = true"})
+    assert full.summary["path_end"] == "lambda_end"
+    assert not any("max_steps" in w for w in full.summary.get("warnings", []))
+
+
 def test_contact_set_violation_is_the_traction_error_in_units_of_the_strength():
     """ContactBlock.set_violation, by which a contact set that still changes after the allowed
     active-set loops is accepted or not: 0 where the frozen set holds; α_N × the opening of a

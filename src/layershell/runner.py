@@ -236,6 +236,24 @@ def _contact_moved(summary: dict, moves: list[dict], step: int, log) -> None:
     moves.clear()
 
 
+def _ended_early(summary: dict, st, steps, log) -> None:
+    """A path (arc length or adaptive steps) that ended at [steps] max_steps before lambda_end:
+    its run is converged - every increment is an equilibrium - but it did not reach the load it
+    was asked for; warn (console, run.log, summary.json 'warnings'). The Gmsh plate with
+    adaptive steps crawled for 1000 increments at λ ≈ 0.4998 of 1 (each tiny increment still took
+    7-9 Newton iterations, so the step-size control never grew them) and said only 'converged'."""
+    import warnings as _w
+
+    m = (f"step {st.step}: the path ended after [steps] max_steps = {steps.max_steps} increments at load factor "
+         f"{st.load_factor:.6g}, before lambda_end = {steps.lambda_end:g} (summary.json 'path_end'): every "
+         "increment is an equilibrium, but the load asked for was not reached. Raise max_steps; where the "
+         "increments stay small (steps.jsonl 'path' sizes: each still takes about target_iterations Newton "
+         "iterations), raise target_iterations or use fixed steps")
+    summary.setdefault("warnings", []).append(m)
+    _w.warn(m, JumpWarning, stacklevel=2)
+    log(f"warning: {m}")
+
+
 def _balance(summary: dict, energy: dict, step: int, log) -> None:
     """Warn once (console, run.log, summary.json 'warnings') at the first step whose energy
     balance error exceeds ENERGY_WARN after energy has been dissipated: the ledger's
@@ -606,6 +624,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                                    "dissipation": float(st.dissipation)}
                     if getattr(st, "end", None):
                         summary["path_end"] = st.end  # lambda_end, complete failure or max_steps
+                        if st.end == "max_steps":
+                            _ended_early(summary, st, spec.path_following, log)
                 jumps.check(st, vals, rec.get("debonded_area"), ctl)
                 energy = ctl.energies(problem, u) if energy_names else None
                 if energy is not None:

@@ -41,9 +41,9 @@ import numpy as np
 
 from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
-                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, dissipation_so_far,
-                     early_blocks, early_refreeze, newton, reaction_scale, record_scale, relax, stabilise,
-                     stagnates)
+                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, contact_hint,
+                     contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze, newton, reaction_scale,
+                     record_scale, relax, stabilise, stagnates)
 from .problem import Problem
 
 
@@ -714,6 +714,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         break
                     if st.mode == "load" or to_end:
                         u_new, res = newton(problem, att.u, att.lam, s)
+                        if not res.converged and contact_to_nodes(
+                                problem, att.u, att.lam, f"its re-solution after new releases: {res.message}"):
+                            total_it += res.iterations  # as load_steps: once more with the contact at the nodes
+                            residuals += res.residuals
+                            u_new, res = newton(problem, att.u, att.lam, s)
                         att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
                     else:  # the same increment again under the same constraint in the new state
                         att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,
@@ -801,9 +806,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
                     cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
                     continue
+                if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
+                    cuts, st.size = 0, size0  # as load_steps: the thesis's contact at the nodes from here on
+                    continue
                 raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
                                        f"cuts ({msg}); the last converged load factor is {lam:.6g}"
-                                       + (cohesive_hint(problem, s) if st.mode == "load" else ""),
+                                       + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem),
                                        lam, residuals[-1] if residuals else float("nan"))
             st.size *= 0.5
         # accepted increment
