@@ -193,11 +193,18 @@ class _ProbeFloors:
         return out
 
 
+def _warn(summary: dict, m: str, category: type, log) -> None:
+    """One warning of a run: summary.json 'warnings', Python's warnings (the console) and run.log."""
+    import warnings as _w
+
+    summary.setdefault("warnings", []).append(m)
+    _w.warn(m, category, stacklevel=3)
+    log(f"warning: {m}")
+
+
 def _relaxed(summary: dict, events: list[dict], energy: dict | None, step: int, log) -> None:
     """summary['relaxations'] gets the unstable jumps that the load stepping relaxed in this step
     ([steps] unstable = 'relax', solver/newton.py relax), each a warning; ``events`` is emptied."""
-    import warnings as _w
-
     fracture = (energy or {}).get("dissipated_fracture", 0.0)
     for ev in events:
         rec = {"step": step, **ev}
@@ -213,9 +220,7 @@ def _relaxed(summary: dict, events: list[dict], energy: dict | None, step: int, 
              + " - booked as viscous dissipation; summary.json 'relaxations'. Between the two states the path "
              "is not followed: use control = 'arc_length' (forces or prescribed displacements) or refine along the "
              "front to trace it")
-        summary.setdefault("warnings", []).append(m)
-        _w.warn(m, JumpWarning, stacklevel=2)
-        log(f"warning: {m}")
+        _warn(summary, m, JumpWarning, log)
     events.clear()
 
 
@@ -223,16 +228,12 @@ def _contact_moved(summary: dict, moves: list[dict], step: int, log) -> None:
     """summary['contact_moved_to_nodes'] gets the moves of the thesis-law contact from the face
     Gauss points to the nodes (InterfaceController.contact_to_nodes) made in this step, each a
     warning; ``moves`` is emptied."""
-    import warnings as _w
-
     from .solver.interface_state import contact_move_message
 
     for mv in moves:
         summary.setdefault("contact_moved_to_nodes", []).append({"step": step, **mv})
         m = f"step {step}: " + contact_move_message(mv)
-        summary.setdefault("warnings", []).append(m)
-        _w.warn(m, ContactRuleWarning, stacklevel=2)
-        log(f"warning: {m}")
+        _warn(summary, m, ContactRuleWarning, log)
     moves.clear()
 
 
@@ -242,16 +243,12 @@ def _ended_early(summary: dict, st, steps, log) -> None:
     was asked for; warn (console, run.log, summary.json 'warnings'). The Gmsh plate with
     adaptive steps crawled for 1000 increments at λ ≈ 0.4998 of 1 (each tiny increment still took
     7-9 Newton iterations, so the step-size control never grew them) and said only 'converged'."""
-    import warnings as _w
-
     m = (f"step {st.step}: the path ended after [steps] max_steps = {steps.max_steps} increments at load factor "
          f"{st.load_factor:.6g}, before lambda_end = {steps.lambda_end:g} (summary.json 'path_end'): every "
          "increment is an equilibrium, but the load asked for was not reached. Raise max_steps; where the "
          "increments stay small (steps.jsonl 'path' sizes: each still takes about target_iterations Newton "
          "iterations), raise target_iterations or use fixed steps")
-    summary.setdefault("warnings", []).append(m)
-    _w.warn(m, JumpWarning, stacklevel=2)
-    log(f"warning: {m}")
+    _warn(summary, m, JumpWarning, log)
 
 
 def _balance(summary: dict, energy: dict, step: int, log) -> None:
@@ -267,8 +264,6 @@ def _balance(summary: dict, energy: dict, step: int, log) -> None:
     lost = sum(energy.get(k, 0.0) for k in ("dissipated_fracture", "dissipated_friction", "dissipated_viscous"))
     if not (abs(err) > ENERGY_WARN and lost > 0) or summary.get("energy_balance_warned"):
         return
-    import warnings as _w
-
     summary["energy_balance_warned"] = step
     m = (f"step {step}: the energy balance is off by {err:.2%} of the external work (external work - stored energy "
          f"- dissipated, summary.json 'energy'; more than {ENERGY_WARN:.0%}): the dissipation the interfaces "
@@ -280,9 +275,7 @@ def _balance(summary: dict, energy: dict, step: int, log) -> None:
          "Under load or displacement control, steps in which a node row releases at once jump across a snap-back "
          "of the path (the load drops at a fixed load factor), and shorter steps do not close that error: "
          "trace the path by control = 'arc_length' (prescribed displacements too)")
-    summary.setdefault("warnings", []).append(m)
-    _w.warn(m, CohesiveWarning, stacklevel=2)
-    log(f"warning: {m}")
+    _warn(summary, m, CohesiveWarning, log)
 
 
 def _stabilized(summary: dict, where: dict, energy: dict | None, step: int, log) -> None:
@@ -295,16 +288,12 @@ def _stabilized(summary: dict, where: dict, energy: dict | None, step: int, log)
     summary["stabilized"] = {**where, "dissipated_viscous": visc,
                              "viscous_share_of_dissipation": visc / total if total > 0 else 0.0}
     if first:
-        import warnings as _w
-
         m = (f"step {step}: no equilibrium of the rate-independent cohesive law near λ = {where['load_factor']:.6g} "
              f"(every cut of the step failed); the viscous regularisation was switched on from there with η = "
              f"{where['viscosity']:.3g} (load-factor units, [steps] stabilize) - the summary's 'stabilized' and "
              "energy.dissipated_viscous show its share of the dissipation; where it is not small, follow the "
              "path by control = 'arc_length' or smaller steps")
-        summary.setdefault("warnings", []).append(m)
-        _w.warn(m, CohesiveWarning, stacklevel=2)
-        log(f"warning: {m}")
+        _warn(summary, m, CohesiveWarning, log)
 
 
 def _path_arrays(st) -> dict[str, np.ndarray]:
