@@ -176,6 +176,10 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     progress in 6 iterations or the set returns to an earlier one (points at ḡ_N ≈ 0 flipping),
     an active-set loop around :func:`newton_fixed_set` from the last iterate (the set is frozen
     during the iterations, then checked), at most ``max_contact_iterations`` iterations in all.
+    Where the thesis's Gauss-point contact may still move to the nodes (:func:`contact_may_move`),
+    a contact set frozen for the third time - a cycle - ends the solve at once, and the caller
+    moves it (:func:`contact_to_nodes`). A contact set still changing after
+    ``max_active_set_loops`` is accepted only within :data:`CONTACT_SET_TOL`.
     Both use the residual line search for contact (full Newton steps in the semi-smooth phase
     cut the pull-off's time by about 10 % but took 2.5× the iterations in the §5.1 plate's first
     debonding step and failed there without any line search).
