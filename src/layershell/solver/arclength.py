@@ -43,7 +43,7 @@ from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
                      active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, contact_hint,
                      contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze, newton, reaction_scale,
-                     record_scale, relax, stabilise, stagnates)
+                     record_scale, relax, resolve, stabilise, stagnates)
 from .problem import Problem
 
 
@@ -713,12 +713,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         ok, msg = False, f"the state still changes after {max_resolves} re-solutions"
                         break
                     if st.mode == "load" or to_end:
-                        u_new, res = newton(problem, att.u, att.lam, s)
-                        if not res.converged and contact_to_nodes(
-                                problem, att.u, att.lam, f"its re-solution after new releases: {res.message}"):
-                            total_it += res.iterations  # as load_steps: once more with the contact at the nodes
-                            residuals += res.residuals
-                            u_new, res = newton(problem, att.u, att.lam, s)
+                        u_new, res = resolve(problem, att.u, att.lam, s)  # as load_steps (contact_to_nodes)
                         att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
                     else:  # the same increment again under the same constraint in the new state
                         att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,

@@ -356,9 +356,7 @@ class InterfaceController:
         moved (the assembler's pattern is then rebuilt; the move is recorded in
         ``contact_moves``, which the runner reports with :func:`contact_move_message`)."""
         moved = []
-        for r in self.runs:
-            if isinstance(r, CohesiveRun) or r.law.rule != "gauss" or not r.law.rule_auto:
-                continue
+        for r in self.movable_contact():
             old = r.block
             new = self._set_rule(problem, r, "lobatto")
             if old.alpha_T is not None:
@@ -373,6 +371,11 @@ class InterfaceController:
         self.contact_moves.append({"load_factor": float(lam), "interfaces": moved, "reason": reason})
         self.contact_moved_at = float(lam)
         return True
+
+    def movable_contact(self) -> list[InterfaceRun]:
+        """The thesis-law runs whose contact :meth:`contact_to_nodes` would move: at the face
+        Gauss points, with the rule left open in the model file (``InterfaceLaw.rule_auto``)."""
+        return [r for r in self.runs if isinstance(r, InterfaceRun) and r.law.rule == "gauss" and r.law.rule_auto]
 
     def _set_rule(self, problem, r: InterfaceRun, rule: str) -> ContactBlock:
         """Rebuild the contact block of the thesis-law run ``r`` on the face points of ``rule``,
@@ -637,9 +640,10 @@ def contact_move_message(move: dict) -> str:
     """The warning for one move of :meth:`InterfaceController.contact_to_nodes`."""
     return (f"at load factor {move['load_factor']:.6g} the contact between debonded layers at the face Gauss points "
             f"(the thesis's points; below {', '.join(repr(m) for m in move['interfaces'])}) found no equilibrium"
-            + (f" ({move['reason']})" if move.get("reason") else "") + "; from there on it acts at the nodes, as with [[interfaces]] rule = \"lobatto\" (the "
-            "stress criterion stays at the Gauss points; summary.json 'contact_moved_to_nodes'). Set rule = \"gauss\" "
-            "to keep the Gauss points (the run then stops there) or rule = \"lobatto\" to use the nodes from the start")
+            + (f" ({move['reason']})" if move.get("reason") else "")
+            + "; from there on it acts at the nodes, as with [[interfaces]] rule = \"lobatto\" (the stress criterion "
+            "stays at the Gauss points; summary.json 'contact_moved_to_nodes'). Set rule = \"gauss\" to keep the "
+            "Gauss points (the run then stops there) or rule = \"lobatto\" to use the nodes from the start")
 
 
 def _kin(block):

@@ -617,18 +617,6 @@ def load_steps(
             committed["u"] = u_c
             return user_end(pb, u_c, lam_c)
 
-    def resolve(u_c: np.ndarray, lam_c: float, may_move: bool = True) -> tuple[np.ndarray, NewtonResult]:
-        """The re-solution at ``lam_c`` from the just committed ``u_c``; where it fails with the
-        thesis's Gauss-point contact, once more with the contact at the nodes (contact_to_nodes)."""
-        u_r, r = newton(problem, u_c, lam_c, s_re)
-        why = f"its re-solution after new releases: {r.message}"
-        if not r.converged and may_move and contact_to_nodes(problem, u_c, lam_c, why):
-            u_r, r2 = newton(problem, u_c, lam_c, s_re)
-            r2.iterations += r.iterations
-            r2.residuals = r.residuals + r2.residuals
-            r = r2
-        return u_r, r
-
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
         total_it, bis, cuts, halved = 0, 0, 0, 0
@@ -649,7 +637,7 @@ def load_steps(
                     if may_cut and cut.measure(problem) - a0 > cut.max_fraction:
                         res = NewtonResult(False, 0, message="debonding jump")
                         break
-                    u_new, res = resolve(u_new, trial, may_move=not may_cut)
+                    u_new, res = resolve(problem, u_new, trial, s_re, may_move=not may_cut)
                     total_it += res.iterations
                     residuals += res.residuals
                     if not res.converged:
@@ -672,11 +660,12 @@ def load_steps(
                 problem.restore(snap)  # the failed Newton solve may have changed contact states
                 committed["u"] = u_snap
             bis += 1
-            if bis > min(s.max_bisections, RELAX_AFTER_CUTS) and contact_to_nodes(
-                    problem, committed["u"], lam, f"towards load factor {trial:.6g} after {bis} bisections: {res.message}"):
+            late = bis > min(s.max_bisections, RELAX_AFTER_CUTS)
+            if late and contact_to_nodes(problem, committed["u"], lam,
+                                         f"towards load factor {trial:.6g} after {bis} bisections: {res.message}"):
                 halved, bis, inc = halved + bis, 0, target - lam  # the rest of the step with the contact at the nodes
                 continue
-            if bis > min(s.max_bisections, RELAX_AFTER_CUTS) and s.unstable == "relax":
+            if late and s.unstable == "relax":
                 rel = relax(problem, u, lam, trial, s, on_step_end)  # the next equilibrium at this load
                 if rel is not None:
                     total_it += rel.iterations
@@ -699,7 +688,7 @@ def load_steps(
             inc *= 0.5
         if on_step_end is not None and cut is None:
             while on_step_end(problem, u, lam):
-                u, res = resolve(u, lam)
+                u, res = resolve(problem, u, lam, s_re)
                 total_it += res.iterations
                 residuals += res.residuals
                 if not res.converged:
@@ -863,10 +852,23 @@ def contact_to_nodes(problem: Problem, u: np.ndarray, lam: float, reason: str = 
 def contact_may_move(problem: Problem) -> bool:
     """Is there thesis-law contact at the face Gauss points that :func:`contact_to_nodes` would
     move (its rule left open in the model file, not moved yet)?"""
-    from ..delamination import InterfaceLaw
+    movable = getattr(problem.interfaces, "movable_contact", None)
+    return movable is not None and bool(movable())
 
-    return any(isinstance(getattr(r, "law", None), InterfaceLaw) and r.law.rule == "gauss" and r.law.rule_auto
-               for r in getattr(problem.interfaces, "runs", ()))
+
+def resolve(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
+            may_move: bool = True) -> tuple[np.ndarray, NewtonResult]:
+    """The re-solution at ``lam`` after new releases, from the just committed ``u``; where it
+    fails with the thesis's Gauss-point contact (and ``may_move``), once more with the contact at
+    the nodes (:func:`contact_to_nodes`). The result counts the iterations of both solves."""
+    u_r, r = newton(problem, u, lam, s)
+    if not r.converged and may_move and contact_to_nodes(problem, u, lam, f"its re-solution after new releases: "
+                                                                           f"{r.message}"):
+        u_r, r2 = newton(problem, u, lam, s)
+        r2.iterations += r.iterations
+        r2.residuals = r.residuals + r2.residuals
+        r = r2
+    return u_r, r
 
 
 def contact_hint(problem: Problem) -> str:
@@ -876,9 +878,8 @@ def contact_hint(problem: Problem) -> str:
     cycle (the §5.1 plate with slip-softening friction on 12 × 12 stopped at λ = 0.375 with a load
     step's budget for its re-solutions; at the nodes it reaches λ = 1 with it, and at the Gauss
     points with :data:`REEQUILIBRATION_BUDGET` in 1884 iterations, against 377 at the
-    nodes; tests/test_delamination.py, docs/user-guide.md). Only where the model file asked for
-    the Gauss points (``rule = "gauss"``): with the rule left open the contact moves to the nodes
-    instead (:func:`contact_to_nodes`), and a later failure says where it moved. '' otherwise."""
+    nodes; tests/test_delamination.py, docs/user-guide.md). Where the contact has moved to the
+    nodes (:func:`contact_to_nodes`, the rule left open) it says where instead. '' otherwise."""
     from ..delamination import InterfaceLaw
 
     moved = getattr(problem.interfaces, "contact_moved_at", None)
