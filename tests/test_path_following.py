@@ -392,6 +392,23 @@ def test_target_iterations_sets_the_step_size_control():
         _spec(FORCE_TIP.format(P=0.5), True, 20, "adaptive = true\ntarget_iterations = 0")
 
 
+def test_increments_whose_iterations_do_not_depend_on_their_size_grow():
+    """arclength.size_insensitive, the exception to the step-size rule Δλ × target/its: an
+    increment 10 % longer than the last that took at most one iteration more, or one 10 %
+    shorter that took at most one fewer, says the count does not follow the size (then the next
+    grows by INSENSITIVE_GROWTH); not beyond twice the target, not without a last increment.
+    The Gmsh plate that it lets reach λ = 1: tests/test_delamination.py."""
+    from layershell.solver.arclength import size_insensitive
+
+    assert size_insensitive(1.2e-5, 8, 1e-5, 7, 8)  # longer, one iteration more
+    assert not size_insensitive(1.2e-5, 9, 1e-5, 7, 8)  # two more: the size matters
+    assert size_insensitive(0.8e-5, 7, 1e-5, 8, 8)  # shorter, one fewer: the cut did not pay
+    assert not size_insensitive(0.8e-5, 6, 1e-5, 8, 8)  # two fewer: it did
+    assert not size_insensitive(1.05e-5, 7, 1e-5, 7, 8)  # the size barely changed
+    assert not size_insensitive(2e-5, 17, 1e-5, 17, 8)  # more than twice the target
+    assert not size_insensitive(2e-5, 5, 0.0, 0, 8)  # the first increment
+
+
 def test_jump_warnings_unit():
     from layershell.solver.arclength import jump_warnings
 
