@@ -504,8 +504,8 @@ def test_a_path_that_ends_at_max_steps_before_lambda_end_is_warned():
     does not. The Gmsh plate with adaptive steps: after its debonding jump at λ = 0.496 every
     increment from 10⁻⁵ up takes 6-12 Newton iterations (the thesis's friction relaxing), so the
     rule Δλ × target/its held the increments near 10⁻⁵ and 1000 of them ended at λ = 0.4998;
-    with the growth of increments whose iterations do not depend on their size
-    (arclength.size_insensitive) it reaches λ = 1 in about 50."""
+    with the growth of cut increments whose iterations do not depend on their size
+    (arclength.size_insensitive) it reaches λ = 1 in 74."""
     from layershell.runner import JumpWarning
 
     adaptive = "[steps]\nn = 8\nadaptive = true"

@@ -396,8 +396,9 @@ def test_increments_whose_iterations_do_not_depend_on_their_size_grow():
     """arclength.size_insensitive, the exception to the step-size rule Δλ × target/its: an
     increment 10 % longer than the last that took at most one iteration more, or one 10 %
     shorter that took at most one fewer, says the count does not follow the size (then the next
-    grows by INSENSITIVE_GROWTH); not beyond twice the target, not without a last increment.
-    The Gmsh plate that it lets reach λ = 1: tests/test_delamination.py."""
+    grows by INSENSITIVE_GROWTH, where the increment was cut below INSENSITIVE_BELOW of the
+    first); not beyond twice the target, not without a last increment. The Gmsh plate that it
+    lets reach λ = 1: tests/test_delamination.py."""
     from layershell.solver.arclength import size_insensitive
 
     assert size_insensitive(1.2e-5, 8, 1e-5, 7, 8)  # longer, one iteration more
