@@ -448,7 +448,9 @@ class Steps(Strict):
     target_iterations: PositiveInt = Field(
         8, le=100, description="control = 'arc_length' or adaptive: the Newton iterations (active-set loops "
         "included) of a normal increment; the next increment is scaled by target_iterations / iterations, within "
-        "[1/2, 2] (adaptive: an increment cut below 1/16 of the first whose iterations do not follow its size grows 1.5x instead). Larger: fewer, longer increments (fewer points on the path, often fewer iterations in all: "
+        "[1/2, 2] (adaptive: an increment cut below 1/16 of the first whose iterations do not follow its size "
+        "grows 1.5x instead). Larger: fewer, longer increments (fewer points on the path, often fewer iterations "
+        "in all: "
         "the force-loaded DCB on 200 elements by arc length took 101 increments and 759 iterations with 8, 55 "
         "and 593 with 16)")
     max_steps: PositiveInt = Field(
