@@ -637,3 +637,28 @@ def test_a_step_that_fails_after_complete_debonding_is_named_a_limit_point():
     pb.bonded[1][:] = False
     pb.interfaces.sync(pb)
     assert "limit point" in separated_hint(pb, 1.0)
+
+
+def test_the_re_solutions_budget_is_per_load_step():
+    """``[delamination] max_resolves`` is the most re-solutions per load step. The pull-off
+    re-solves 1, 15, 2 and 9 times in four of its steps up to λ = 0.5 (27 in all). Before, the count
+    was never reset (InterfaceController.begin_step was not called), so a budget of 20 stopped
+    the run at λ = 0.475 with an internal error (RuntimeError), and the weak-friction §5.1 plate on
+    24 × 24 stopped so at λ = 0.625 (110 re-solutions in six steps). Now a budget of 20
+    reaches the end with the default's results; a budget of 10 stops at the step that needs
+    15, as a failed solution (ConvergenceError) that names the setting and keeps the converged
+    steps."""
+    to_half = {"0.50,\n           0.525, 0.55, 0.60, 0.65, 0.70, 0.75]": "0.50]"}  # the steps up to λ = 0.5
+    ref = run_example("pulloff", to_half)
+    per_step = [s["resolves"] for s in ref.summary["steps"]]
+    assert max(per_step) == 15 and sum(per_step) > 20
+    budget = "[steps]"
+    ok = run_example("pulloff", {**to_half, budget: "[delamination]\nmax_resolves = 20\n\n" + budget})
+    assert ok.converged
+    assert [s["resolves"] for s in ok.summary["steps"]] == per_step
+    assert ok.summary["probes"] == pytest.approx(ref.summary["probes"], rel=1e-12, abs=1e-15)
+    short = run_example("pulloff", {**to_half, budget: "[delamination]\nmax_resolves = 10\n\n" + budget})
+    assert not short.converged
+    assert "more than 10 re-solutions" in short.message and "max_resolves" in short.message
+    first = per_step.index(15)
+    assert len(short.summary["steps"]) == first  # the steps before the one that needs 15

@@ -603,6 +603,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                 if ctl is not None:
                     rec["resolves"] = resolves["n"]
                     resolves["n"] = 0
+                    ctl.begin_step()  # [delamination] max_resolves counts per step
                     rec["debonded_area"] = ctl.debonded_area()
                     rec["debonded_extent"] = ctl.debonded_extent()
                     summary["debonded_area"].append({"step": st.step, "load_factor": st.load_factor,

@@ -226,6 +226,10 @@ class InterfaceController:
 
     # ------------------------------------------------------------------ per step
     def begin_step(self) -> None:
+        """A load step (or path increment) was recorded: the next one starts its own count of
+        re-solutions (``[delamination] max_resolves`` is per load step; before this was called,
+        the count ran over the whole run, from its start or restart, and the weak-friction §5.1
+        plate on 24 × 24 stopped at λ = 0.625 after 110 re-solutions spread over six steps)."""
         self.resolves = 0
 
     def update(self, problem, u: np.ndarray, lam: float) -> bool:
@@ -332,8 +336,15 @@ class InterfaceController:
             self.resolves += int(self.settings.reequilibrate)
         self.sync(problem)
         if self.resolves > self.settings.max_resolves:
-            raise RuntimeError(f"more than {self.settings.max_resolves} re-solutions at load factor {lam:.6g}; "
-                               "the debonding does not stabilise (unstable delamination)")
+            from .newton import ConvergenceError
+
+            raise ConvergenceError(
+                f"more than {self.settings.max_resolves} re-solutions at load factor {lam:.6g} (the debonded "
+                f"fraction of the interfaces is now {self.debonded_fraction():.3g}): the debonding does not "
+                "stabilise at this load, each re-solution releasing more node regions (unstable delamination). "
+                "The converged steps are kept; raise [delamination] max_resolves (re-solutions per load step) to "
+                "follow the cascade to its end, or, where the whole interface is expected to debond, read this "
+                "load factor as the limit of the bond", lam, float("nan"))
         return new_any and self.settings.reequilibrate
 
     # ------------------------------------------------------------------ contact rule
