@@ -643,7 +643,10 @@ class DelaminationDef(Strict):
     friction: Literal["return_mapping", "explicit"] = Field(
         "return_mapping", description="friction as a penalty return mapping (implicit), or as explicit loads (thesis)")
     max_release: PositiveInt | None = Field(None, description="nodes released per re-solution (largest V first)")
-    max_resolves: PositiveInt = Field(100, description="most re-solutions (release, solve again) per load step")
+    max_resolves: PositiveInt = Field(
+        1000, description="most re-solutions (release, solve again) per load step: a limit on the cost of a "
+        "cascade (each re-solution releases at least one node, so a cascade ends by itself; the CFRP plate on "
+        "24 x 16 needs more than 130 at one load)")
     max_debond_fraction: float | None = Field(
         None, gt=0, le=1,
         description="step cutting: a load increment whose re-solutions debond more than this fraction of the "

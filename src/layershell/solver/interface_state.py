@@ -137,7 +137,9 @@ class CohesiveRun:
 @dataclass
 class DelaminationSettings:
     max_release: int | None = None  # nodes released per re-solution (largest V first)
-    max_resolves: int = 100
+    # re-solutions per load step at most: a cost limit, since each re-solution releases at least
+    # one node, so a cascade ends by itself (the CFRP plate on 24 × 16 needed more than 130 at λ = 32)
+    max_resolves: int = 1000
     friction: str = "return_mapping"  # or "explicit"
     # step cutting: a (sub)step whose re-solutions debond more than this fraction of the interface
     # area is undone and its load increment halved (at most ``max_debond_cuts`` times per step)
