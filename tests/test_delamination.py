@@ -662,3 +662,33 @@ def test_the_re_solutions_budget_is_per_load_step():
     assert "more than 10 re-solutions" in short.message and "max_resolves" in short.message
     first = per_step.index(15)
     assert len(short.summary["steps"]) == first  # the steps before the one that needs 15
+
+
+def test_a_restart_keeps_the_contact_move_and_the_peak(tmp_path):
+    """summary.json of a restarted run keeps what earlier steps recorded once: the move of the
+    thesis's contact to the nodes (``contact_moved_to_nodes``) and ``peak_load_factor`` were not
+    among the checkpoint's summary keys, so a run restarted after the move reported none (the
+    weak-friction §5.1 plate on 24 × 24, moved at λ = 0.167 and restarted twice). The Gmsh plate
+    moves at λ = 0.5 (step 4); stopped after step 6 and restarted, it ends with the same move
+    record and the same displacements as the uninterrupted run."""
+    import numpy as np
+
+    from layershell.io.build import build, parse
+    from layershell.runner import run
+
+    path = EXAMPLES / "plate_gmsh.toml"
+    spec = build(parse(path.read_text(), str(path)), path.parent)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    (move,) = full.summary["contact_moved_to_nodes"]
+    assert move["step"] == 4
+
+    def stop(i, n, lam):
+        if i == 6:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.converged and again.summary["restarts"][-1]["step"] == 6
+    assert again.summary["contact_moved_to_nodes"] == full.summary["contact_moved_to_nodes"]
+    assert np.allclose(again.u, full.u, rtol=0, atol=1e-9 * abs(full.u).max())

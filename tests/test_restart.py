@@ -295,6 +295,28 @@ def test_restart_errors_are_bad_input(tiny, tmp_path):
         assert "Traceback" not in r.output
 
 
+def test_restart_with_a_version_of_other_defaults_says_so(tiny):
+    """The checkpoint's model hash covers the validated model with its defaults, so a version
+    that fills in another default (``[delamination] max_resolves`` went from 100 to 1000)
+    refuses a checkpoint of the same model file. The message then says that the file is the
+    same (summary.json next to the checkpoint holds the run's model text) and the defaults
+    differ, instead of "the model file changed"."""
+    import dataclasses
+
+    full = tiny.parent / "full"
+    ck = checkpoint.load(full)
+    spec = load(tiny)
+    checkpoint.check_compatible(ck, spec, ck.u.size, full)  # the same version: accepted
+    other = dataclasses.replace(ck, model_hash="0" * 64)  # as if written with other defaults
+    with pytest.raises(checkpoint.CheckpointError, match="fills in other defaults"):
+        checkpoint.check_compatible(other, spec, ck.u.size, full)
+    edited = tiny.parent / "edited.toml"  # the file of the run edited: the message says so
+    edited.write_text(tiny.read_text(encoding="utf-8").replace("sigma_max = 1980.0", "sigma_max = 1900.0"),
+                      encoding="utf-8")
+    with pytest.raises(checkpoint.CheckpointError, match="different model"):
+        checkpoint.check_compatible(other, load(edited), ck.u.size, full)
+
+
 def test_restart_of_a_finished_run_changes_nothing(tiny, tmp_path):
     """Restarting from the last step solves nothing and reports the same steps and probes."""
     full = tiny.parent / "full"

@@ -89,7 +89,8 @@ def _jsonable(obj):
 #: (the stabilisation, the relaxed jumps and the solver's counters included - a restart once
 #: dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
 SUMMARY_KEYS = ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end",
-                "stabilized", "relaxations", "active_set", "linear_solves", "energy_balance_warned")
+                "stabilized", "relaxations", "active_set", "linear_solves", "energy_balance_warned",
+                "peak_load_factor", "contact_moved_to_nodes")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,
@@ -183,6 +184,16 @@ def load(where: str | Path) -> Checkpoint:
 def check_compatible(ck: Checkpoint, spec, n_full: int, where: str | Path) -> None:
     """Raise CheckpointError unless ``ck`` was written by a run of this model."""
     if ck.model_hash != model_hash(spec):
+        try:  # the run's model file as summary.json next to the checkpoint holds it
+            text = json.loads((locate(where).parent / "summary.json").read_text(encoding="utf-8")).get("model_text")
+            same_text = text is not None and spec.path is not None and Path(spec.path).read_text(encoding="utf-8") == text
+        except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+            same_text = False
+        if same_text:  # the hash covers the validated model with its defaults
+            raise CheckpointError(f"--restart '{where}': the model file is the one of that run, but this layershell "
+                                  "version fills in other defaults for what the file leaves out (the checkpoint "
+                                  "would continue a different model); rerun without --restart, or finish the run "
+                                  "with the version that wrote the checkpoint")
         raise CheckpointError(f"--restart '{where}': the checkpoint was written for a different model (the model "
                               "file or its mesh changed since: only [output], title and units may change); "
                               "restart with the model file of that run, or rerun without --restart")
