@@ -382,3 +382,36 @@ def test_restart_continues_the_solver_counters(tmp_path):
     assert total["factorisations"] > before["factorisations"]
     # the same run in two parts: about the uninterrupted count (the restart factorises once more)
     assert abs(total["krylov_solves"] - ref["krylov_solves"]) <= 0.2 * ref["krylov_solves"]
+
+
+def test_restart_after_the_peak_keeps_the_peak_load_factor(tmp_path):
+    """summary.json's ``peak_load_factor`` is the largest λ of the whole path, also after a
+    restart (it was not among the checkpoint's summary keys, so a run restarted after the peak
+    reported the largest λ since the restart). The force-loaded DCB on 50 elements by arc
+    length (25 increments, about 8 s): its λ peaks at increment 15 and falls after it; stopped
+    after increment 17 and restarted, the run ends with the uninterrupted run's peak and path."""
+    from helpers import EXAMPLES
+
+    from layershell.io.build import build, parse
+
+    text = (EXAMPLES / "dcb_cohesive.toml").read_text()
+    i = text.index("factors = [0.01")
+    text = text[:i] + 'control = "arc_length"\nn = 20\nmax_steps = 25' + text[text.index("\n", i):]
+    text = text.replace("nx = 150", "nx = 50")
+    spec = build(parse(text, str(EXAMPLES / "dcb.toml")), EXAMPLES)
+    full = run(spec, tmp_path / "full", write_vtu=False)
+    lams = [s["load_factor"] for s in full.summary["steps"]]
+    k = lams.index(max(lams)) + 1  # the increment of the peak (1-based)
+    assert full.summary["peak_load_factor"] == pytest.approx(max(lams), rel=1e-12)
+    assert k + 2 < len(lams) and max(lams[k + 2:]) < max(lams)  # it falls after the peak
+
+    def stop(i, n, lam):
+        if i == k + 2:
+            raise KeyboardInterrupt
+
+    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    assert part.interrupted
+    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
+    assert again.summary["restarts"][-1]["step"] == k + 2
+    assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-9)
+    assert again.summary["peak_load_factor"] == pytest.approx(full.summary["peak_load_factor"], rel=1e-12)
