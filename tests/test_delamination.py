@@ -664,7 +664,7 @@ def test_the_re_solutions_budget_is_per_load_step():
     assert len(short.summary["steps"]) == first  # the steps before the one that needs 15
 
 
-def test_a_restart_keeps_the_contact_move_and_the_peak(tmp_path):
+def test_a_restart_keeps_the_contact_move(tmp_path):
     """summary.json of a restarted run keeps what earlier steps recorded once: the move of the
     thesis's contact to the nodes (``contact_moved_to_nodes``) and ``peak_load_factor`` were not
     among the checkpoint's summary keys, so a run restarted after the move reported none (the
