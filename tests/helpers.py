@@ -21,6 +21,19 @@ TIGHT_STEPS = "tolerance = 1e-12\nmax_contact_iterations = 400"
 TIGHT_BOUND = 1e-9
 
 
+def stopped_and_restarted(spec, folder: Path, after: int):
+    """Run ``spec`` into ``folder``, stopped as by Ctrl-C after step ``after``, then continue it
+    there with ``restart``: ``(part, again)``, the two RunResults."""
+
+    def stop(i, n, lam):
+        if i == after:
+            raise KeyboardInterrupt
+
+    part = run(spec, folder, progress=stop, write_vtu=False)
+    again = run(spec, folder, write_vtu=False, restart=folder)
+    return part, again
+
+
 def run_example(name: str, replace: dict[str, str] | None = None, out=None, newton: dict | None = None):
     """Run ``examples/<name>.toml`` (optionally with text replacements and Newton settings
     changed, e.g. ``newton={"semismooth_iterations": 0}``); return the RunResult."""

@@ -3,7 +3,7 @@ import re
 
 import numpy as np
 import pytest
-from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS, run_example
+from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS, run_example, stopped_and_restarted
 
 from layershell.delamination import InterfaceLaw
 from layershell.interfaces import interface_state, interfaces
@@ -682,13 +682,8 @@ def test_a_restart_keeps_the_contact_move(tmp_path):
     (move,) = full.summary["contact_moved_to_nodes"]
     assert move["step"] == 4
 
-    def stop(i, n, lam):
-        if i == 6:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", 6)
     assert part.interrupted
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert again.converged and again.summary["restarts"][-1]["step"] == 6
     assert again.summary["contact_moved_to_nodes"] == full.summary["contact_moved_to_nodes"]
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-9 * abs(full.u).max())

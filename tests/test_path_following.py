@@ -12,6 +12,8 @@ from layershell.io.build import build, parse
 from layershell.runner import run
 from layershell.solver.problem import Problem
 
+from helpers import stopped_and_restarted
+
 CANTILEVER = """
 [model]
 title = "cantilever"
@@ -326,13 +328,8 @@ def _restart_matches_uninterrupted(spec, tmp_path):
     lams = [s["load_factor"] for s in full.summary["steps"]]
     assert lams[-1] == 1.0 and len(lams) >= 3 and full.summary["path_end"] == "lambda_end"
 
-    def stop(i, n, lam):
-        if i == 2:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", 2)
     assert part.interrupted and len(part.summary["steps"]) == 2
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert again.converged
     assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-12)
     assert [s["iterations"] for s in again.summary["steps"]] == [s["iterations"] for s in full.summary["steps"]]
@@ -453,13 +450,8 @@ def test_displacement_control_restart(tmp_path):
     spec = _spec(DISP_TIP.format(w=3.0), True, 4)
     full = run(spec, tmp_path / "full", write_vtu=False)
 
-    def stop(i, n, lam):
-        if i == 2:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", 2)
     assert part.interrupted
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert again.converged and full.converged
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-12 * abs(full.u).max())
     assert again.summary["probes"]["w"] == pytest.approx(3.0, rel=1e-12)

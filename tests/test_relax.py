@@ -10,7 +10,7 @@ the front jumps an element (measured; README, known limits)."""
 import numpy as np
 import pytest
 
-from helpers import EXAMPLES, run_example
+from helpers import EXAMPLES, run_example, stopped_and_restarted
 from layershell.io.build import InputError, build, parse
 from layershell.solver import newton as nw
 from layershell.solver.problem import Problem
@@ -186,14 +186,9 @@ def test_restart_after_a_relaxed_step_repeats_the_uninterrupted_run(tmp_path):
     full = run(spec, tmp_path / "full", write_vtu=False)
     assert full.converged
 
-    def stop(i, n, lam):
-        if i == 7:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", 7)
     assert part.interrupted and len(part.summary["steps"]) == 7
     assert [r["step"] for r in part.summary["relaxations"]] == [7]
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert again.converged
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-10 * abs(full.u).max())
     a, b = full.summary, again.summary
@@ -227,13 +222,8 @@ def test_restart_of_a_stabilised_run_repeats_the_uninterrupted_run(tmp_path):
     k = lams.index(pytest.approx(0.645))
     assert a["stabilized"]["load_factor"] == pytest.approx(0.64) and k + 1 < len(lams)
 
-    def stop(i, n, lam):
-        if i == k + 1:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", k + 1)
     assert part.interrupted and part.summary["stabilized"]["load_factor"] == pytest.approx(0.64)
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     b = again.summary
     assert not again.converged and b["error"] == a["error"] and b["failure"]["step"] == a["failure"]["step"]
     assert [s["load_factor"] for s in b["steps"]] == pytest.approx(lams, rel=1e-12)

@@ -29,6 +29,8 @@ from layershell.cli import app
 from layershell.io.build import load
 from layershell.runner import run
 
+from helpers import stopped_and_restarted
+
 ROOT = Path(__file__).resolve().parents[1]
 N_STEPS = 12  # of 0.125: the signal tests send theirs after step 2 or 6, with the later steps as slack
 DEBOND_STEP = 6  # λ = 0.75: the step in which the tiny model debonds
@@ -369,13 +371,8 @@ def test_restart_continues_the_solver_counters(tmp_path):
     spec = load(model)
     full = run(spec, tmp_path / "full", write_vtu=False)
 
-    def stop(i, n, lam):
-        if i == DEBOND_STEP:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", DEBOND_STEP)
     before = part.summary["linear_solves"]
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert full.converged and part.interrupted and again.converged
     total, ref = again.summary["linear_solves"], full.summary["linear_solves"]
     assert before["krylov_solves"] > 0 and total["krylov_solves"] > before["krylov_solves"]
@@ -405,13 +402,8 @@ def test_restart_after_the_peak_keeps_the_peak_load_factor(tmp_path):
     assert full.summary["peak_load_factor"] == pytest.approx(max(lams), rel=1e-12)
     assert k + 2 < len(lams) and max(lams[k + 2:]) < max(lams)  # it falls after the peak
 
-    def stop(i, n, lam):
-        if i == k + 2:
-            raise KeyboardInterrupt
-
-    part = run(spec, tmp_path / "part", progress=stop, write_vtu=False)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", k + 2)
     assert part.interrupted
-    again = run(spec, tmp_path / "part", write_vtu=False, restart=tmp_path / "part")
     assert again.summary["restarts"][-1]["step"] == k + 2
     assert [s["load_factor"] for s in again.summary["steps"]] == pytest.approx(lams, rel=1e-9)
     assert again.summary["peak_load_factor"] == pytest.approx(full.summary["peak_load_factor"], rel=1e-12)
