@@ -555,13 +555,15 @@ def test_a_cycling_contact_set_is_not_accepted_with_interpenetration():
     from layershell.solver.newton import CONTACT_SET_TOL
 
     gauss = run_example("plate_gmsh", GAUSS_CONTACT)
-    assert not gauss.converged and gauss.summary["steps"][-1]["load_factor"] == 0.375
+    assert not gauss.converged and gauss.summary["steps"][-1]["load_factor"] < 1.0
     m = re.search(r"violates the contact condition by a traction of ([0-9.e+-]+) × the interface strength",
                   gauss.message)
     assert m and float(m.group(1)) > 100 * CONTACT_SET_TOL
     moved = run_example("plate_gmsh")
     assert moved.converged and moved.summary["steps"][-1]["load_factor"] == 1.0
-    assert [mv["load_factor"] for mv in moved.summary["contact_moved_to_nodes"]] == [0.5]
+    # where the Gauss points' set cycles (round-off decides which re-solution cycles first: λ =
+    # 0.5 with numpy 1.26-2.3, 0.875 with numpy 2.4 / MKL 2026.2; either stops the Gauss run)
+    assert [mv["load_factor"] for mv in moved.summary["contact_moved_to_nodes"]] == [gauss.failure["load_factor"]]
     assert "active_set" not in moved.summary  # every contact set held exactly where it converged
 
 
@@ -669,8 +671,9 @@ def test_a_restart_keeps_the_contact_move(tmp_path):
     thesis's contact to the nodes (``contact_moved_to_nodes``) and ``peak_load_factor`` were not
     among the checkpoint's summary keys, so a run restarted after the move reported none (the
     weak-friction §5.1 plate on 24 × 24, moved at λ = 0.167 and restarted twice). The Gmsh plate
-    moves at λ = 0.5 (step 4); stopped after step 6 and restarted, it ends with the same move
-    record and the same displacements as the uninterrupted run."""
+    moves in one of its steps (step 4 or 7: round-off decides where its Gauss points' contact set
+    cycles first); stopped after that step and restarted, it ends with the same move record and
+    the same displacements as the uninterrupted run."""
     import numpy as np
 
     from layershell.io.build import build, parse
@@ -680,10 +683,11 @@ def test_a_restart_keeps_the_contact_move(tmp_path):
     spec = build(parse(path.read_text(), str(path)), path.parent)
     full = run(spec, tmp_path / "full", write_vtu=False)
     (move,) = full.summary["contact_moved_to_nodes"]
-    assert move["step"] == 4
+    after = move["step"]
+    assert after < len(full.summary["steps"])  # a step follows the move
 
-    part, again = stopped_and_restarted(spec, tmp_path / "part", 6)
+    part, again = stopped_and_restarted(spec, tmp_path / "part", after)
     assert part.interrupted
-    assert again.converged and again.summary["restarts"][-1]["step"] == 6
+    assert again.converged and again.summary["restarts"][-1]["step"] == after
     assert again.summary["contact_moved_to_nodes"] == full.summary["contact_moved_to_nodes"]
     assert np.allclose(again.u, full.u, rtol=0, atol=1e-9 * abs(full.u).max())

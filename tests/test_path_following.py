@@ -180,10 +180,13 @@ class SofteningSpring:
 
     def law(self, d):
         """(force, tangent) of the damage law at δ = d with the current history; at the peak
-        (κ = δ0 within round-off) the tangent of further loading is the softening one."""
+        (κ = δ0 within the solver's tolerance, 10⁻⁶) the tangent of further loading is the
+        softening one. (With 10⁻⁹ the increment that ends at the peak, converged to a residual of
+        5·10⁻⁹, left κ 5.8·10⁻⁹ below δ0 with numpy 2.4 / MKL 2026.2: the spring stayed elastic
+        and no later increment converged.)"""
         DF = self.df
         k = max(self.kappa, d)
-        at_peak = d >= self.kappa and k >= D0 * (1 - 1e-9)
+        at_peak = d >= self.kappa and k >= D0 * (1 - 1e-6)
         if k < D0 and not at_peak:
             return K0 * d, K0
         k = max(k, D0)
@@ -593,7 +596,10 @@ def test_displacement_control_by_arc_length_traces_the_snap_back():
     assert lam[j] == pytest.approx(df / U_BAR, rel=1e-6) and np.all(np.diff(lam[i:j + 1]) < 0)
     assert np.all(np.diff(d[i:]) >= -1e-12)  # the crack only opens
     assert sum(p[4] for p in pts) == pytest.approx(0.5 * FP * df, rel=1e-6)
-    assert all(p[4] >= -1e-12 for p in pts)
+    # no increment dissipates a negative energy beyond the equilibrium tolerance: the elastic
+    # increment to the peak, converged to a residual of 5·10⁻⁹, books -2.2·10⁻¹² (7·10⁻¹⁰ of the
+    # total) with numpy 2.4 / MKL 2026.2 (the bound was -10⁻¹² absolute before)
+    assert all(p[4] >= -1e-8 * 0.5 * FP * df for p in pts)
     assert "dissipation" in {p[3] for p in pts} and pts[-1][3] == "arc"
     assert lam[-1] == 1.0 and pts[-1][5] == "lambda_end" and abs(F[-1]) <= 1e-8 * FP  # (the spring keeps 1e-9 F_p)
     # past the separation the dissipation constraint is not tried again and again: its predictor
