@@ -264,9 +264,9 @@ def test_frozen_opening_point_jumps_at_closure_and_is_released():
     computed here), within a band of about 10⁻³ λ0 where the continuation's damage is bounded
     at -10³ - practically a jump, which Newton iterates crossing it cannot pass (the
     force-loaded DCB's failed arc-length increments). Closed (out of both sets) the point's
-    traction K δ_n is continuous and monotone there. ``release_crossed`` takes the opening,
-    loading points that an iterate closes out of both sets, and leaves every point whose
-    separation has not passed through zero as it was."""
+    traction K δ_n is continuous and monotone there. ``release_closed`` takes exactly the
+    opening, loading points that an iterate closes out of both sets and leaves every other
+    point as it was."""
     from layershell.cohesive import onset, point_response
 
     pb, blk, ur = _damaged_problem("lobatto")
@@ -289,73 +289,16 @@ def test_frozen_opening_point_jumps_at_closure_and_is_released():
     u0 = pb.op.T @ ur
     blk.freeze(u0)
     tension, loading = (a.copy() for a in blk.frozen)
-    assert blk.release_crossed(u0) == 0  # nothing has crossed at the freezing state
-    assert blk.release_crossed(2.0 * u0) == 0  # nor further along the same direction
+    assert blk.release_closed(u0) == 0  # nothing frozen opening is closed at the freezing state
     assert all(np.array_equal(a, b) for a, b in zip(blk.frozen, (tension, loading)))
-    u1 = -u0  # every separation reversed: the opening points close, the others' slip turns back
-    closed = tension & loading & (blk.gap(u1) < 0)
-    assert closed.sum() >= 2
-    assert blk.release_crossed(u1) == loading.sum()
-    assert np.array_equal(blk.frozen[0], tension & ~closed)  # only the closed points leave the opening set
-    assert not blk.frozen[1].any()  # every loading point crossed zero
-    assert blk.release_crossed(u1) == 0  # done: the released points stay out within the solve
+    u1 = -u0  # every separation reversed: the opening points close
+    crossed = tension & loading & (blk.gap(u1) < 0)
+    assert crossed.sum() >= 2
+    assert blk.release_closed(u1) == crossed.sum()
+    assert np.array_equal(blk.frozen[0], tension & ~crossed) and np.array_equal(blk.frozen[1], loading & ~crossed)
+    assert blk.release_closed(u1) == 0  # done: the closed points stay closed within the solve
     blk.unfreeze()
-    assert blk.release_crossed(u1) == 0  # nothing frozen
-
-
-def test_frozen_shear_point_jumps_where_its_slip_reverses_and_is_released():
-    """The shear counterpart (the cohesive §5.1 plate by arc length, MITC9 with friction, crawled
-    through increments that each failed where a new point's onset was crossed): a point frozen
-    as loading in compression follows t = K λ0 (λf - λ)/(λf - λ0) δ_s/|δ_s|, so its shear
-    traction reverses where the slip passes through zero - a jump of almost twice the shear
-    strength between δ_s = ±ε. Out of the loading set (damage held) the traction K (1 - d) δ_s
-    is continuous there. ``release_crossed`` takes a loading point whose damageable separation
-    turned against its direction at freezing out of the loading set (not out of the tension
-    set), and no other point."""
-    from layershell.cohesive import onset, point_response
-
-    pb, blk, ur = _damaged_problem("lobatto")
-    K, law = blk.K, blk.law
-    n = np.array([[0.0, 0.0, 1.0]])
-    d_old = np.array([0.0])
-    l0 = float(onset(np.ones(1), K, law)[0][0])  # pure mode II
-    lf = 2.0 * law.G_IIc / (K * l0)
-    eps = 0.01 * l0
-    jump = 2.0 * K * l0 * (lf - eps) / (lf - l0)
-    loading = (np.array([False]), np.array([True]))  # compression, loading
-    tp, _, _ = point_response(np.array([[eps, 0.0, 0.0]]), n, d_old, K, law, tangent=False, frozen=loading)
-    tm, _, _ = point_response(np.array([[-eps, 0.0, 0.0]]), n, d_old, K, law, tangent=False, frozen=loading)
-    assert tp[0, 0] - tm[0, 0] == pytest.approx(jump, rel=1e-6)
-    assert jump > 1.9 * law.tau_max
-    held = (np.array([False]), np.array([False]))
-    tp, _, _ = point_response(np.array([[eps, 0.0, 0.0]]), n, d_old, K, law, tangent=False, frozen=held)
-    tm, _, _ = point_response(np.array([[-eps, 0.0, 0.0]]), n, d_old, K, law, tangent=False, frozen=held)
-    assert tp[0, 0] - tm[0, 0] == pytest.approx(2.0 * K * eps, rel=1e-9)
-
-    # on the block: freeze every point as loading in compression, then reverse the tangential
-    # separation of one point only (its normal part kept)
-    u0 = pb.op.T @ ur
-    blk.freeze(u0)
-    ne, nq = blk.d_old.shape
-    tension = np.zeros((ne, nq), bool)
-    every = np.ones((ne, nq), bool)
-    blk.frozen = (tension, every)
-    blk.frozen_separation = blk._damageable(u0, tension)[0]
-    slip = np.linalg.norm(blk.frozen_separation, axis=-1)
-    e, q = np.unravel_index(np.argmax(slip), slip.shape)
-    assert slip[e, q] > 0
-    g0 = blk.frozen_separation.copy()
-    g1 = g0.copy()
-    g1[e, q] = -g0[e, q]
-    turned = np.einsum("eqi,eqi->eq", g1, g0) < 0
-    assert turned.sum() >= 1
-    blk.frozen_separation = g0
-    dn = blk.gap(u0)
-    blk._damageable = lambda u, t: (g1, dn)  # the separations of an iterate that reversed that slip
-    assert blk.release_crossed(u0) == turned.sum()
-    assert np.array_equal(blk.frozen[0], tension)
-    assert np.array_equal(blk.frozen[1], every & ~turned)
-    blk.unfreeze()
+    assert blk.release_closed(u1) == 0  # nothing frozen
 
 
 def test_partial_symmetry_check_equals_the_full_pass():

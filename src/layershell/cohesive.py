@@ -382,7 +382,6 @@ class CohesiveBlock:
     K: float
     d_old: np.ndarray  # (e, q) converged damage (history variable)
     frozen: tuple | None = None  # (tension, loading) during an active-set solve
-    frozen_separation: np.ndarray | None = None  # (e, q, 3) damageable separation where frozen (release_crossed)
     # viscous regularisation (Gao & Bower 2004), law.viscosity = η > 0: the acting damage d_v
     # follows the rate-independent d with ḋ_v = (d - d_v)/η in load-factor time, backward Euler
     # d_v = (d_v,old + r d)/(1 + r), r = Δλ/η (never decreasing)
@@ -460,58 +459,34 @@ class CohesiveBlock:
             if worst > 0.0:
                 loading = np.where(viol >= (1.0 - 1e-6) * worst, loading, prev)
         self.frozen = (tension, loading)
-        self.frozen_separation = self._damageable(u_full, tension)[0]
 
-    def _damageable(self, u_full: np.ndarray, tension: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """The damageable part of the separation, <δ_n> n + δ_s (e, q, 3), with the normal part
-        counted where ``tension`` holds (the vector whose length is λ), and δ_n (e, q)."""
-        delta = self.separation(u_full)
-        n = self.contact.A3
-        dn = np.einsum("eqi,eqi->eq", delta, n)
-        return delta - np.where(tension, 0.0, dn)[..., None] * n, dn
+    def release_closed(self, u_full: np.ndarray) -> int:
+        """Take the points frozen as opening and loading whose normal separation is negative at
+        ``u_full`` out of both sets (closed, damage held); returns how many.
 
-    def release_crossed(self, u_full: np.ndarray) -> int:
-        """Take the frozen loading points whose separation has passed through zero at ``u_full``
-        out of the loading set (damage held); returns how many. Points frozen as opening whose
-        normal separation is negative (closed) also leave the opening set.
-
-        Within the frozen sets the traction of a loading point is K (1 - d(λ)) g with λ = |g|,
-        g = <δ_n> n + δ_s its damageable separation and d on the softening line, t = K λ0 (λf -
-        λ)/(λf - λ0) g/λ: it reverses where g passes through zero, within about 10⁻³ λ0 where the
-        continued damage is bounded at -10³ - practically a jump of twice the strength.
-
-        - Mode I: a Newton iterate that pushes the point just behind a crack front across δ_n = 0
-          - the first correction of an increment often does, the point opening only by about
-          λ0 - is then thrown back, and the iterates alternate between the two sides for good
-          (the force-loaded DCB on 200 elements, arc length: 122 of 418 attempts failed so,
-          their residual frozen at one point's jump). Such a point is taken out of both sets
-          (closed: K δ_n is continuous across δ_n = 0).
-        - Shear: a point frozen as loading at its onset in shear (the predictor overloads it)
-          has a tangent near zero there (K - K λ0/λ), and the first correction can drive its
-          slip backwards through zero: the cohesive §5.1 plate by arc length (MITC9, friction,
-          6 × 6) jumped from +1209 to -1207 kN/m² at one point, the residual grew from 5 to 540
-          and every increment that crossed a new point's onset failed so, the next one cut by
-          half: the path crawled towards each onset. A point whose g turned against its
-          direction when frozen (g · g_frozen < 0) is taken out of the loading set.
-
-        Out of the set, the point's law is continuous there (damage held), so the frozen
-        problem is continuous again; where the point loads at the solution after all, the set
-        check finds it (:meth:`set_violation`) and the active-set loop freezes it again. Only
-        this direction changes, so the release cannot cycle within one solve."""
+        Within the frozen sets the traction of such a point is K (1 - d(λ)) δ with λ = |δ|
+        and d on the softening line, t = K λ0 (λf - λ)/(λf - λ0) δ/λ: it reverses where δ
+        passes through zero (in mode I at δ_n = 0), within about 10⁻³ λ0 where the continued
+        damage is bounded at -10³ - practically a jump of twice the strength. A Newton iterate that
+        pushes the point just behind a crack front across it - the first correction of an
+        increment often does, the point opening only by about λ0 - is then thrown back, and
+        the iterates alternate between the two sides for good (the force-loaded DCB on 200
+        elements, arc length: 122 of 418 attempts failed so, their residual frozen at one
+        point's jump). Closed, the point's law is continuous there (K δ_n across δ_n = 0), so
+        the frozen problem is continuous again; where the point opens at the solution after
+        all, the set check finds it (:meth:`set_violation`) and the active-set loop freezes it
+        opening again. Only this direction changes, so the release cannot cycle within one
+        solve."""
         if self.frozen is None or self.frozen[1] is None:
             return 0
         tension, loading = self.frozen
-        if not np.any(loading):
+        if not np.any(tension & loading):
             return 0
-        g, dn = self._damageable(u_full, tension)
-        closed = tension & loading & (dn < 0.0)
-        g0 = self.frozen_separation
-        turned = np.zeros_like(loading)
-        if g0 is not None and g0.shape == g.shape:
-            turned = loading & ~closed & (np.einsum("eqi,eqi->eq", g, g0) < 0.0)
-        n = int(closed.sum() + turned.sum())
+        g = self.gap(u_full)
+        crossed = tension & loading & (g < 0.0)
+        n = int(crossed.sum())
         if n:
-            self.frozen = (tension & ~closed, loading & ~closed & ~turned)
+            self.frozen = (tension & ~crossed, loading & ~crossed)
         return n
 
     def set_changed(self, u_full: np.ndarray) -> bool:
@@ -548,7 +523,6 @@ class CohesiveBlock:
 
     def unfreeze(self) -> None:
         self.frozen = None
-        self.frozen_separation = None
 
     # the attributes that assembly / results read from a block
     @property
