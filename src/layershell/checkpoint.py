@@ -186,9 +186,9 @@ def check_compatible(ck: Checkpoint, spec, n_full: int, where: str | Path) -> No
     if ck.model_hash != model_hash(spec):
         try:  # the run's model file as summary.json next to the checkpoint holds it
             text = json.loads((locate(where).parent / "summary.json").read_text(encoding="utf-8")).get("model_text")
-            same_text = text is not None and spec.path is not None and Path(spec.path).read_text(encoding="utf-8") == text
         except (OSError, UnicodeDecodeError, ValueError, AttributeError):
-            same_text = False
+            text = None
+        same_text = text is not None and spec.model_text() == text
         if same_text:  # the hash covers the validated model with its defaults
             raise CheckpointError(f"--restart '{where}': the model file is the one of that run, but this layershell "
                                   "version fills in other defaults for what the file leaves out (the checkpoint "

@@ -363,14 +363,6 @@ class RunResult:
     signal: str | None = None  # "SIGINT" or "SIGTERM" when interrupted
 
 
-def _model_text(spec: RunSpec) -> str | None:
-    """The model file's text as run (embedded in the report)."""
-    try:
-        return spec.path.read_text(encoding="utf-8") if spec.path is not None else None
-    except (OSError, UnicodeDecodeError):
-        return None
-
-
 def _rebase(entries: list, old: Path, new: Path) -> list[tuple[float, str]]:
     """ParaView series entries (paths relative to ``old``) relative to ``new``."""
     if old.resolve() == new.resolve():
@@ -437,7 +429,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         "title": spec.source.model.title,
         "model_file": str(spec.path) if spec.path is not None else None,
         "model_hash": hash_,
-        "model_text": _model_text(spec),
+        "model_text": spec.model_text(),
         "version": _version(),
         "units": model.units,
         "converged": False,

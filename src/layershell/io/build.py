@@ -75,6 +75,14 @@ class RunSpec:
     warnings: list[str] = field(default_factory=list)  # input that is valid but almost surely not meant
     path_following: object = None  # solver.arclength.PathSettings ([steps] control/adaptive), None: fixed steps
 
+    def model_text(self) -> str | None:
+        """The model file's text as run (summary.json ``model_text``; the restart check compares
+        it), None without a readable file."""
+        try:
+            return self.path.read_text(encoding="utf-8") if self.path is not None else None
+        except (OSError, UnicodeDecodeError):
+            return None
+
 
 def _fmt_loc(loc) -> str:
     out = ""
