@@ -34,15 +34,20 @@ def stopped_and_restarted(spec, folder: Path, after: int):
     return part, again
 
 
-def run_example(name: str, replace: dict[str, str] | None = None, out=None, newton: dict | None = None):
-    """Run ``examples/<name>.toml`` (optionally with text replacements and Newton settings
-    changed, e.g. ``newton={"semismooth_iterations": 0}``); return the RunResult."""
+def example_spec(name: str, replace: dict[str, str] | None = None):
+    """The RunSpec of ``examples/<name>.toml`` with text replacements (each must occur)."""
     path = EXAMPLES / f"{name}.toml"
     text = path.read_text()
     for a, b in (replace or {}).items():
         assert a in text, f"{a!r} not in {name}.toml"
         text = text.replace(a, b)
-    spec = build(parse(text, str(path)), path.parent)
+    return build(parse(text, str(path)), path.parent)
+
+
+def run_example(name: str, replace: dict[str, str] | None = None, out=None, newton: dict | None = None):
+    """Run ``examples/<name>.toml`` (optionally with text replacements and Newton settings
+    changed, e.g. ``newton={"semismooth_iterations": 0}``); return the RunResult."""
+    spec = example_spec(name, replace)
     if newton:
         import dataclasses
 

@@ -3,7 +3,7 @@ import re
 
 import numpy as np
 import pytest
-from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS, run_example, stopped_and_restarted
+from helpers import EXAMPLES, TIGHT_BOUND, TIGHT_STEPS, example_spec, run_example, stopped_and_restarted
 
 from layershell.delamination import InterfaceLaw
 from layershell.interfaces import interface_state, interfaces
@@ -677,13 +677,9 @@ def test_a_restart_keeps_the_contact_move(tmp_path):
     moves in one of its steps (step 4 or 7: round-off decides where its Gauss points' contact set
     cycles first); stopped after that step and restarted, it ends with the same move record and
     the same displacements as the uninterrupted run."""
-    import numpy as np
-
-    from layershell.io.build import build, parse
     from layershell.runner import run
 
-    path = EXAMPLES / "plate_gmsh.toml"
-    spec = build(parse(path.read_text(), str(path)), path.parent)
+    spec = example_spec("plate_gmsh")
     full = run(spec, tmp_path / "full", write_vtu=False)
     (move,) = full.summary["contact_moved_to_nodes"]
     after = move["step"]

@@ -29,7 +29,7 @@ from layershell.cli import app
 from layershell.io.build import load
 from layershell.runner import run
 
-from helpers import stopped_and_restarted
+from helpers import example_spec, stopped_and_restarted
 
 ROOT = Path(__file__).resolve().parents[1]
 N_STEPS = 12  # of 0.125: the signal tests send theirs after step 2 or 6, with the later steps as slack
@@ -387,15 +387,8 @@ def test_restart_after_the_peak_keeps_the_peak_load_factor(tmp_path):
     reported the largest λ since the restart). The force-loaded DCB on 50 elements by arc
     length (25 increments, about 8 s): its λ peaks at increment 15 and falls after it; stopped
     after increment 17 and restarted, the run ends with the uninterrupted run's peak and path."""
-    from helpers import EXAMPLES
-
-    from layershell.io.build import build, parse
-
-    text = (EXAMPLES / "dcb_cohesive.toml").read_text()
-    i = text.index("factors = [0.01")
-    text = text[:i] + 'control = "arc_length"\nn = 20\nmax_steps = 25' + text[text.index("\n", i):]
-    text = text.replace("nx = 150", "nx = 50")
-    spec = build(parse(text, str(EXAMPLES / "dcb.toml")), EXAMPLES)
+    spec = example_spec("dcb_cohesive", {"nx = 150": "nx = 50",  # the fixed steps commented out
+                                         "factors = [0.01": 'control = "arc_length"\nn = 20\nmax_steps = 25 #'})
     full = run(spec, tmp_path / "full", write_vtu=False)
     lams = [s["load_factor"] for s in full.summary["steps"]]
     k = lams.index(max(lams)) + 1  # the increment of the peak (1-based)
