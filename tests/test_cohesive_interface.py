@@ -183,6 +183,7 @@ def test_state_round_trip_for_restart():
     r1, r2 = ctl.runs[0], pb2.interfaces.runs[0]
     assert np.array_equal(r1.block.d_old, r2.block.d_old) and r1.block.d_old.max() > 0
     assert np.array_equal(r1.energy, r2.energy) and np.array_equal(ctl.energy, pb2.interfaces.energy)
+    assert np.array_equal(r1.fracture, r2.fracture) and r1.fracture.max() > 0  # per point (the VTU's)
     assert float(r2.first_damage) == 0.5
     f1, _ = pb.assembler.evaluate(u, tangent=False)
     f2, _ = pb2.assembler.evaluate(u, tangent=False)

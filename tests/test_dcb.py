@@ -228,6 +228,36 @@ def test_nodal_integration_avoids_traction_oscillations():
 
 
 
+def test_fracture_energy_per_point_tells_the_process_zone_from_the_debonded_zone():
+    """The interface VTU's `fracture_energy` per point, on the DCB (mode I) opened under
+    displacement control until the crack has grown by a few nodes (150 elements, δ = 4.5 mm).
+    Independent reference: every point that debonded along its (proportional, mode I) path has
+    dissipated G_Ic, the input fracture energy (closed form of the bilinear law). With the stiff
+    default penalty the process-zone points ahead of them have damage d > 0.98, yet they have
+    dissipated only part of G_Ic: `damage` alone makes the process zone look debonded, the
+    `process_zone` flag and `fracture_energy` tell it apart. The points' energies sum, weighted by
+    their areas, to the ledger's `dissipated_fracture`."""
+    from layershell.export import interface_mesh
+    from layershell.interfaces import interfaces
+
+    r = run_example("dcb_cohesive", {**DISPLACEMENT_CONTROL, "factors = [0.01, 0.02, 0.05,":
+                                     "factors = [0.1, 0.2, 0.3, 0.35, 0.4, 0.45] #"})
+    assert r.converged
+    run = r.problem.interfaces.runs[0]
+    w, frac, d = run.block.contact.w, run.fracture, run.block.d_old
+    assert (w * frac).sum() == pytest.approx(r.summary["energy"]["dissipated_fracture"], rel=1e-12)
+    debonded = run.block.released & ~run.initial
+    zone = (d > 0) & ~run.block.released
+    assert debonded.sum() >= 3 and zone.sum() >= 3  # the crack has grown and a process zone leads it
+    np.testing.assert_allclose(frac[debonded], GIC, rtol=1e-6)
+    assert np.all(frac[run.initial] == 0.0)  # the starter crack dissipated nothing
+    assert d[zone].max() > 0.98 and 0.0 < frac[zone].min() and frac[zone].max() < 0.9 * GIC
+    pb = r.problem
+    pd = interface_mesh(pb.model, pb.dm, r.u, interfaces(pb.model)[0], run=run, load_factor=0.45).point_data
+    assert pd["process_zone"].sum() == zone.sum() and pd["debonded"].sum() == run.block.released.sum()
+    assert np.sort(pd["fracture_energy"]) == pytest.approx(np.sort(frac.ravel()), abs=1e-15)
+
+
 @pytest.mark.slow
 def test_force_loaded_dcb_by_arc_length_to_complete_separation():
     """The force-loaded DCB on 150 elements traced by arc length (dissipation constraint) from the

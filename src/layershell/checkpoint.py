@@ -35,7 +35,8 @@ import numpy as np
 
 from .io.output import atomic_write
 
-FORMAT_VERSION = 1
+# 2: the cohesive interfaces' fracture energy per point (CohesiveRun.fracture), 27 Nov 2026
+FORMAT_VERSION = 2
 FILENAME = "checkpoint.npz"
 
 

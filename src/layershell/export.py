@@ -254,7 +254,12 @@ def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None, 
         n = run.block.contact.A3
         gap = np.einsum("eqi,eqi->eq", delta, n)
         slip = delta - gap[..., None] * n
-        point_data.update({"damage": pick(run.block.d_old), "debonded": pick(run.block.released.astype(np.int8)),
+        d = run.block.d_old
+        point_data.update({"damage": pick(d), "debonded": pick(run.block.released.astype(np.int8)),
+                           # softening, not yet debonded: with a stiff penalty d is close to 1 over
+                           # the whole process zone, which only the energy tells apart
+                           "process_zone": pick(((d > 0) & ~run.block.released).astype(np.int8)),
+                           "fracture_energy": pick(run.fracture),
                            "gap": pick(gap), "slip": pick(slip), "slip_magnitude": pick(np.linalg.norm(slip, axis=-1))})
     elif run is not None:
         # delamination state lives at the 9 face Gauss points; each belongs to exactly one node

@@ -63,6 +63,10 @@ class CohesiveRun:
     energy: np.ndarray  # [fracture, friction, viscous] dissipated so far (energy)
     first_damage: np.ndarray  # () load factor of the first damage (nan: none yet)
     initial: np.ndarray  # (e, q) points of initially debonded zones
+    # (e, q) fracture energy per area dissipated so far at each point (the ledger's energy[0]
+    # point by point: Σ w·fracture = energy[0]); G_c(B) where a point debonded along a proportional
+    # path, between 0 and G_c in the process zone
+    fracture: np.ndarray
     first_failure: float | None = None  # first point fully debonded
     onset_B: float | None = None  # mode ratio B = G_II/G_T of the points that damaged first
 
@@ -102,6 +106,7 @@ class CohesiveRun:
         fric = 0.5 * np.einsum("eqi,eqi->eq", self.t_fric + tf, dslip)
         self.energy = self.energy + np.array([float((w * frac).sum()), float((w * fric).sum()),
                                               float((w * visc).sum())])
+        self.fracture = self.fracture + frac
         blk.d_old, blk.dv_old, blk.lam_old = d_inv, d, float(lam)
         self.delta, self.t_fric = delta, tf
         fresh = ~self.initial  # initially debonded zones do not count as new damage
@@ -702,7 +707,7 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
         d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
     blk = CohesiveBlock(cb, law, K, d0, dv_old=d0.copy())
     return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
-                       np.array(np.nan), d0 > 0)
+                       np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
 
 
 def _arm(model, k: int, direction: np.ndarray, normal: np.ndarray) -> Arm:
