@@ -506,6 +506,48 @@ def test_complete_failure_needs_a_dissipating_increment():
     assert not complete_failure(0.3, -0.01, 0.6, 0.02, 10.0, 1e-3)
 
 
+def test_a_force_path_that_unloads_without_damage_is_stopped():
+    """``unloading``: on a force path by arc length the load and its conjugate displacement fall
+    together only where interfaces debond (a snap-back) or after complete failure. Once λ lies
+    more than 5 % of its peak below the last increment that damaged, in an increment in which
+    λ and F̂·u both fell, the path follows elastic or frictional unloading (a variant of the
+    release of closed points, not kept, took the cohesive slab of tests/test_slab_trc_soffit.py
+    from its snap-back at λ = 278 down to 0 so, reported as complete failure). Not past an
+    elastic limit point (the load falls, the displacement grows), not within 5 %, not before
+    any damage, not while the load rises."""
+    from layershell.solver.arclength import UNLOADING_FRACTION, unloading
+
+    peak, lam_d = 327.0, 278.0
+    below = lam_d - 1.2 * UNLOADING_FRACTION * peak
+    assert unloading(below, -2.0, -1.0, lam_d, peak)
+    assert not unloading(below, -2.0, +1.0, lam_d, peak)  # snap-through: the displacement grows
+    assert not unloading(lam_d - 0.8 * UNLOADING_FRACTION * peak, -2.0, -1.0, lam_d, peak)  # not yet
+    assert not unloading(below, -2.0, -1.0, float("nan"), peak)  # nothing damaged yet
+    assert not unloading(below, +2.0, -1.0, lam_d, peak)  # the load rises
+
+
+def test_damage_booked_counts_fracture_not_friction():
+    """The dissipation constraint's increments must be booked by damage (fracture and its
+    viscous part) in the interfaces' ledger: friction dissipates on unloading paths too, and
+    the slab's friction met Δτ while it unloaded (test above). ``damage_booked`` sums
+    the ledger's fracture and viscous energies of every cohesive interface, not its friction."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).parent))
+    from test_cohesive_interface import strip
+
+    from layershell.solver.arclength import damage_booked
+
+    spec = strip(nonlinear="false", nx=2, load="0.5", steps=1, cohesive={"smax": 0.3, "tmax": 0.6})
+    pb = Problem.build(spec.model)
+    (r,) = pb.interfaces.runs
+    assert damage_booked(pb) == 0.0
+    r.energy = np.array([1.5, 7.0, 0.25])  # fracture, friction, viscous
+    assert damage_booked(pb) == 1.75
+    assert pb.interfaces.dissipation() == (1.5, 0.25)
+
+
 def test_a_path_that_no_longer_advances_is_stopped():
     """``crawling``: 25 increments within end_fraction × the peak of λ that together dissipated
     less than end_fraction of the energy dissipated so far - the increments have been cut to

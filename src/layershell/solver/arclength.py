@@ -104,6 +104,7 @@ class PathState:
     changed: bool = False  # the last increment changed the state (debonding): work criterion next
     last_increment: float = 0.0  # |Δλ| of the last load-controlled increment (size_insensitive)
     last_iterations: int = 0  # and its Newton iterations
+    lam_damaged: float = math.nan  # λ of the last increment in which damage grew (force paths; unloading())
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
@@ -111,7 +112,8 @@ class PathState:
                "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
                "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed),
                "path.last_increment": np.array(self.last_increment),
-               "path.last_iterations": np.array(self.last_iterations)}
+               "path.last_iterations": np.array(self.last_iterations),
+               "path.lam_damaged": np.array(self.lam_damaged)}
         if self.du_prev is not None:
             out["path.du_prev"] = self.du_prev.copy()
         return out
@@ -125,7 +127,8 @@ class PathState:
                    float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
                    float(a["path.arc_length0"]), bool(a["path.changed"]),
                    float(a["path.last_increment"]) if "path.last_increment" in a else 0.0,
-                   int(a["path.last_iterations"]) if "path.last_iterations" in a else 0)
+                   int(a["path.last_iterations"]) if "path.last_iterations" in a else 0,
+                   float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan)
 
 
 @dataclass
@@ -680,10 +683,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         f_itf0 = interface_forces(problem, u)[0] if itf_form else None  # the start's (committed) state
         b0 = (balance_terms(problem, u) if arc and ps.energy_tolerance is not None and on_step_end is not None
               else None)  # the ledger at the start (energy_control)
-        # the ledger's dissipation at the start (displacement paths: CONSTRAINT_BOOKED)
-        booked0 = (problem.interfaces.dissipated_total()
-                   if displacement_path and on_step_end is not None and hasattr(problem.interfaces, "dissipated_total")
-                   else None)
+        # the ledger's dissipation at the start (CONSTRAINT_BOOKED)
+        booked0 = (damage_booked(problem) if on_step_end is not None and getattr(problem.interfaces, "cohesive", None)
+                   and problem.interfaces.cohesive() else None)
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
@@ -733,12 +735,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
             if ok and booked0 is not None and st.mode == "dissipation":
-                # the constraint takes the stored energy to be the secant one; where the crack faces
-                # close (contact is stiffer than the secant) an elastic path meets it without damage
-                # - the prescribed opening of the DCB on 100 elements 'converged' from δ = 6.2 mm
-                # back to 0 in one increment. The interfaces' own ledger must book the dissipation
-                if problem.interfaces.dissipated_total() - booked0 < CONSTRAINT_BOOKED * st.size:
-                    ok, msg = False, "the dissipation constraint was met by closure, not damage"
+                # the constraint takes the stored energy to be the secant one; where the structure
+                # unloads stiffer than the secant (crack faces closing, contact, friction) an
+                # elastic path meets it without damage - the prescribed opening of the DCB on 100
+                # elements 'converged' from δ = 6.2 mm back to 0 in one increment, and past its peak
+                # the force-loaded slab of tests/test_path_following.py from λ = 238 to 0 in
+                # increments that halved λ each, its friction dissipating the Δτ. The interfaces'
+                # ledger must book the dissipation, by damage (friction also dissipates where a
+                # structure unloads: it does not tell the damage path from unloading)
+                if damage_booked(problem) - booked0 < CONSTRAINT_BOOKED * st.size:
+                    ok, msg = False, "the dissipation constraint was met by elastic unloading, not damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
@@ -824,6 +830,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0,
                                    None if conj is None else (reaction, conj[1]))
         st.dissipated += dG
+        # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
+        dD = damage_booked(problem) - booked0 if booked0 is not None else None
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
@@ -847,7 +855,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
             elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
             floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
-            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
+            if (ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor
+                    and (dD is None or dD >= CONSTRAINT_BOOKED * dG)):  # by damage, not friction alone
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
         else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
             # down where this one was longer (else a short bond's peak lies inside one increment)
@@ -866,8 +875,23 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         if st.mode == "load":
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
         else:
-            st.finished = (to_end or lam >= end
-                           or complete_failure(lam, dlam, st.lam_peak, dG, st.dissipated, ps.end_fraction))
+            st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
+                           or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
+                                               st.dissipated, ps.end_fraction))
+            if dD is not None and not displacement_path:
+                if dD > 1e-9 * max(damage_booked(problem), 1e-300):
+                    st.lam_damaged = lam
+                elif not st.finished and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak):
+                    raise ConvergenceError(
+                        f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
+                        f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
+                        f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
+                        f"the branch on which the interfaces debond - past a snap-back its constrained "
+                        f"iterations found no state with damage growth. The states up to here are kept; the "
+                        f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
+                        f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
+                        f"load and reports the energy it releases; or refine the mesh along the debonding front",
+                        lam, residuals[-1] if residuals else float("nan"))
         recent = (recent + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
         recent_dG = (recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
         crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
@@ -911,8 +935,15 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
 #: back to the dissipation constraint
 ELASTIC_INCREMENT = 1e-6
 
-#: under displacement control by arc length, a dissipation-controlled increment whose interfaces
-#: booked less than this share of the prescribed dissipation Δτ is not accepted (closure)
+def damage_booked(problem: Problem) -> float:
+    """The energy the cohesive interfaces' ledger has booked as dissipated by damage so far
+    (fracture and its viscous regularisation; not friction)."""
+    return float(sum(problem.interfaces.dissipation()))
+
+
+#: a dissipation-controlled increment whose interfaces booked less than this share of the
+#: prescribed dissipation Δτ by damage (:func:`damage_booked`) is not accepted (elastic or
+#: frictional unloading met the constraint; force and displacement paths)
 CONSTRAINT_BOOKED = 0.5
 
 #: load control: the growth of an increment whose iterations do not depend on its size
@@ -979,6 +1010,26 @@ def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissip
     interface debonded, unloaded along its secant and was reported as failed."""
     return (lam_peak > 0 and dlam < 0 and lam <= end_fraction * lam_peak
             and dG > 1e-9 * max(dissipated, 1e-300))
+
+
+#: a force path by arc length whose load factor fell by this share of its peak since the last
+#: increment that damaged an interface has left the debonding branch (:func:`unloading`)
+UNLOADING_FRACTION = 0.05
+
+
+def unloading(lam: float, dlam: float, work_rate: float, lam_damaged: float, lam_peak: float) -> bool:
+    """Does a force path unload without damage? In this increment the load and its work-conjugate
+    displacement both fell (Δλ < 0, ``work_rate`` = F̂·Δu < 0), and λ lies by more than
+    :data:`UNLOADING_FRACTION` of its peak below the λ of the last increment that booked damage.
+    On a force path by arc length the load and the displacement fall together where the
+    interfaces debond (a snap-back) or after complete failure; a path that does so without
+    damage follows elastic or frictional unloading, an equilibrium path but not the structure's
+    response to its load: the slab of tests/test_path_following.py went from λ = 278 to 0 so (its
+    friction met the dissipation constraint) and ended as 'complete failure' with 1.5 % of its
+    interface debonded. (Past an elastic limit point, buckling, the load falls while the
+    displacement grows: not unloading.)"""
+    return (dlam < 0 and work_rate < 0 and lam_peak > 0 and math.isfinite(lam_damaged)
+            and lam < lam_damaged - UNLOADING_FRACTION * lam_peak)
 
 
 def full_weights(problem: Problem) -> np.ndarray:

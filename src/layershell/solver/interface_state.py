@@ -579,12 +579,6 @@ class InterfaceController:
         coh = [r for r in self.runs if isinstance(r, CohesiveRun)]
         return sum(float(r.energy[0]) for r in coh), sum(float(r.energy[2]) for r in coh)
 
-    def dissipated_total(self) -> float:
-        """Fracture + friction + viscous: all the energy the cohesive interfaces' ledger has
-        booked as dissipated so far (the arc length's dissipation constraint measures the same
-        from the work, :func:`~layershell.solver.arclength.dissipation_increment`)."""
-        return sum(float(r.energy[0] + r.energy[1] + r.energy[2]) for r in self.runs if isinstance(r, CohesiveRun))
-
     # ------------------------------------------------------------------ results
     def first_failure(self) -> float | None:
         vals = [r.first_failure for r in self.runs if r.first_failure is not None]
