@@ -739,8 +739,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
                 # elastic path meets it without damage - the prescribed opening of the DCB on 100
                 # elements 'converged' from δ = 6.2 mm back to 0 in one increment, and past its peak
-                # the force-loaded slab of tests/test_path_following.py from λ = 238 to 0 in
-                # increments that halved λ each, its friction dissipating the Δτ. The interfaces'
+                # the force-loaded cohesive soffit slab (docs/performance.md; with a release rule
+                # not kept) from λ = 238 to 0 in increments that halved λ each, its friction
+                # dissipating the Δτ. The interfaces'
                 # ledger must book the dissipation, by damage (friction also dissipates where a
                 # structure unloads: it does not tell the damage path from unloading)
                 if damage_booked(problem) - booked0 < CONSTRAINT_BOOKED * st.size:
@@ -1024,8 +1025,9 @@ def unloading(lam: float, dlam: float, work_rate: float, lam_damaged: float, lam
     On a force path by arc length the load and the displacement fall together where the
     interfaces debond (a snap-back) or after complete failure; a path that does so without
     damage follows elastic or frictional unloading, an equilibrium path but not the structure's
-    response to its load: the slab of tests/test_path_following.py went from λ = 278 to 0 so (its
-    friction met the dissipation constraint) and ended as 'complete failure' with 1.5 % of its
+    response to its load: the cohesive soffit slab (docs/performance.md, with a release rule not
+    kept) went from λ = 278 to 0 so (its friction met the dissipation constraint) and ended as
+    'complete failure' with 1.5 % of its
     interface debonded. (Past an elastic limit point, buckling, the load falls while the
     displacement grows: not unloading.)"""
     return (dlam < 0 and work_rate < 0 and lam_peak > 0 and math.isfinite(lam_damaged)
