@@ -526,26 +526,25 @@ def test_a_force_path_that_unloads_without_damage_is_stopped():
     assert not unloading(below, +2.0, -1.0, lam_d, peak)  # the load rises
 
 
-def test_damage_booked_counts_fracture_not_friction():
-    """The dissipation constraint's increments must be booked by damage (fracture and its
-    viscous part) in the interfaces' ledger: friction dissipates on unloading paths too, and
-    the slab's friction met Δτ while it unloaded (test above). ``damage_booked`` sums
-    the ledger's fracture and viscous energies of every cohesive interface, not its friction."""
+def test_ledger_books_damage_apart_from_friction():
+    """``ledger_booked``: (all, by damage) the energy the cohesive interfaces' ledger has booked.
+    A dissipation-controlled increment must be booked in all (elastic unloading meets the
+    constraint without any); only damage marks the branch on which the interfaces debond, since
+    friction dissipates on unloading paths too (``unloading`` above)."""
     import sys
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).parent))
     from test_cohesive_interface import strip
 
-    from layershell.solver.arclength import damage_booked
+    from layershell.solver.arclength import ledger_booked
 
     spec = strip(nonlinear="false", nx=2, load="0.5", steps=1, cohesive={"smax": 0.3, "tmax": 0.6})
     pb = Problem.build(spec.model)
     (r,) = pb.interfaces.runs
-    assert damage_booked(pb) == 0.0
+    assert ledger_booked(pb) == (0.0, 0.0)
     r.energy = np.array([1.5, 7.0, 0.25])  # fracture, friction, viscous
-    assert damage_booked(pb) == 1.75
-    assert pb.interfaces.dissipation() == (1.5, 0.25)
+    assert ledger_booked(pb) == (8.75, 1.75)
 
 
 def test_a_path_that_no_longer_advances_is_stopped():

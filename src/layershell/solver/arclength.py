@@ -684,8 +684,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         b0 = (balance_terms(problem, u) if arc and ps.energy_tolerance is not None and on_step_end is not None
               else None)  # the ledger at the start (energy_control)
         # the ledger's dissipation at the start (CONSTRAINT_BOOKED)
-        booked0 = (damage_booked(problem) if on_step_end is not None and getattr(problem.interfaces, "cohesive", None)
-                   and problem.interfaces.cohesive() else None)
+        # the ledger at the start (all dissipation, by damage): CONSTRAINT_BOOKED, unloading
+        ledger0 = (ledger_booked(problem)
+                   if on_step_end is not None and hasattr(problem.interfaces, "dissipation") else None)
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
@@ -734,18 +735,15 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
-            if ok and booked0 is not None and st.mode == "dissipation":
+            if ok and ledger0 is not None and displacement_path and st.mode == "dissipation":
                 # the constraint takes the stored energy to be the secant one; where the structure
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
                 # elastic path meets it without damage - the prescribed opening of the DCB on 100
-                # elements 'converged' from δ = 6.2 mm back to 0 in one increment, and past its peak
-                # the force-loaded cohesive soffit slab (docs/performance.md; with a release rule
-                # not kept) from λ = 238 to 0 in increments that halved λ each, its friction
-                # dissipating the Δτ. The interfaces'
-                # ledger must book the dissipation, by damage (friction also dissipates where a
-                # structure unloads: it does not tell the damage path from unloading)
-                if damage_booked(problem) - booked0 < CONSTRAINT_BOOKED * st.size:
-                    ok, msg = False, "the dissipation constraint was met by elastic unloading, not damage"
+                # elements 'converged' from δ = 6.2 mm back to 0 in one increment. The interfaces' own ledger must book the dissipation (displacement paths; on force
+                # paths it also refused the unloading of the lap shear with friction past its peak,
+                # which `unloading` below stops with a clearer message)
+                if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
+                    ok, msg = False, "the dissipation constraint was met by closure, not damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
@@ -832,7 +830,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                                    None if conj is None else (reaction, conj[1]))
         st.dissipated += dG
         # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
-        dD = damage_booked(problem) - booked0 if booked0 is not None else None
+        dD = (ledger_booked(problem)[1] - ledger0[1]
+              if ledger0 is not None and problem.interfaces.cohesive() else None)
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
@@ -856,8 +855,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
             elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
             floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
-            if (ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor
-                    and (dD is None or dD >= CONSTRAINT_BOOKED * dG)):  # by damage, not friction alone
+            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
         else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
             # down where this one was longer (else a short bond's peak lies inside one increment)
@@ -880,7 +878,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                            or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
                                                st.dissipated, ps.end_fraction))
             if dD is not None and not displacement_path:
-                if dD > 1e-9 * max(damage_booked(problem), 1e-300):
+                if dD > 1e-9 * max(ledger_booked(problem)[1], 1e-300):
                     st.lam_damaged = lam
                 elif not st.finished and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak):
                     raise ConvergenceError(
@@ -936,15 +934,17 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
 #: back to the dissipation constraint
 ELASTIC_INCREMENT = 1e-6
 
-def damage_booked(problem: Problem) -> float:
-    """The energy the cohesive interfaces' ledger has booked as dissipated by damage so far
-    (fracture and its viscous regularisation; not friction)."""
-    return float(sum(problem.interfaces.dissipation()))
+def ledger_booked(problem: Problem) -> tuple[float, float]:
+    """The energy the cohesive interfaces' ledger has booked as dissipated so far: in all
+    (fracture, viscous, friction), and by damage alone (fracture and its viscous regularisation,
+    not friction)."""
+    damage = float(sum(problem.interfaces.dissipation()))
+    return damage + problem.interfaces.friction_dissipated(), damage
 
 
-#: a dissipation-controlled increment whose interfaces booked less than this share of the
-#: prescribed dissipation Δτ by damage (:func:`damage_booked`) is not accepted (elastic or
-#: frictional unloading met the constraint; force and displacement paths)
+#: under displacement control by arc length, a dissipation-controlled increment whose interfaces
+#: booked less than this share of the prescribed dissipation Δτ (:func:`ledger_booked`) is not
+#: accepted (closure)
 CONSTRAINT_BOOKED = 0.5
 
 #: load control: the growth of an increment whose iterations do not depend on its size

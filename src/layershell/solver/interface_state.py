@@ -574,6 +574,10 @@ class InterfaceController:
         """Whether any interface has the cohesive law."""
         return any(isinstance(r, CohesiveRun) for r in self.runs)
 
+    def friction_dissipated(self) -> float:
+        """The energy friction on the cohesive interfaces' damaged share has dissipated so far."""
+        return sum(float(r.energy[1]) for r in self.runs if isinstance(r, CohesiveRun))
+
     def dissipation(self) -> tuple[float, float]:
         """(fracture, viscous): the energy the cohesive interfaces have dissipated so far."""
         coh = [r for r in self.runs if isinstance(r, CohesiveRun)]
