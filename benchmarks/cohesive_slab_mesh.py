@@ -20,25 +20,21 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_slab_trc_soffit import COHESIVE, EXAMPLE  # noqa: E402
+from helpers import example_spec  # noqa: E402
+from test_slab_trc_soffit import COHESIVE  # noqa: E402
 
-from layershell.io.build import build, parse  # noqa: E402
 from layershell.runner import run  # noqa: E402
 
 
 def study(mesh: str, to: float = 100.0, relax: bool = False, arc: bool = False) -> dict:
     nx, ny = (int(v) for v in mesh.split("x"))
-    text = EXAMPLE.read_text()
     steps = f"n = {round(to / 5)}\n" + ('unstable = "relax"\n' if relax else "")
     if arc:
         steps += 'control = "arc_length"\nmax_steps = 3000\n'
     repl = {**COHESIVE, "n = 20\n": steps, "lambda_end = 100.0": f"lambda_end = {to!r}",
             "nx = 8\nny = 6": f"nx = {nx}\nny = {ny}"}
-    for a, b in repl.items():
-        assert a in text, a
-        text = text.replace(a, b)
     t0 = time.perf_counter()
-    r = run(build(parse(text, str(EXAMPLE)), EXAMPLE.parent), None, write_vtu=False)
+    r = run(example_spec("slab_trc_soffit", repl), None, write_vtu=False)
     s = r.summary
     last = s["steps"][-1] if s["steps"] else {"load_factor": 0.0, "probes": {}}
     at100 = next((st for st in s["steps"] if abs(st["load_factor"] - 100.0) < 1e-9), None)

@@ -531,10 +531,6 @@ def test_ledger_books_damage_apart_from_friction():
     A dissipation-controlled increment must be booked in all (elastic unloading meets the
     constraint without any); only damage marks the branch on which the interfaces debond, since
     friction dissipates on unloading paths too (``unloading`` above)."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).parent))
     from test_cohesive_interface import strip
 
     from layershell.solver.arclength import ledger_booked

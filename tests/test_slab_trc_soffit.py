@@ -8,6 +8,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from helpers import example_spec
 from layershell.io.build import build, parse
 from layershell.runner import run
 
@@ -128,7 +129,6 @@ def test_slab_example_first_step_and_figure(tmp_path):
     assert not (tmp_path / "load_displacement_load.png").exists()  # no λ-against-λ panel
 
 
-
 #: the example with a cohesive TRC-concrete interface (the fracture energies of
 #: examples/cantilever_plate_cohesive.toml) loaded to 400 kN/m² - not an example file: a model
 #: of a new user (docs/user-guide.md, "A slab with a cohesive soffit layer")
@@ -138,11 +138,7 @@ COHESIVE = {"sigma_max = 1980.0": 'law = "cohesive"\nsigma_max = 1980.0',
 
 
 def _cohesive_slab(extra: dict[str, str] | None = None):
-    text = EXAMPLE.read_text()
-    for a, b in {**COHESIVE, **(extra or {})}.items():
-        assert a in text
-        text = text.replace(a, b)
-    return run(build(parse(text, str(EXAMPLE)), EXAMPLE.parent), None, write_vtu=False)
+    return run(example_spec("slab_trc_soffit", {**COHESIVE, **(extra or {})}), None, write_vtu=False)
 
 
 def _limit(r) -> tuple[float, float]:
@@ -159,9 +155,9 @@ def test_cohesive_soffit_end_debonding_load_converges_with_the_mesh():
     path snaps back: load control finds equilibria up to λ_c and none at λ_c + its last
     bisection. With the cohesive law that load is mesh-objective: 8 × 6 and 16 × 12 within
     1 % (measured 327.13 and 325.45 kN/m²; the relaxed jump reaches 50 % of the interface on
-    both), while the onset of damage at the bearings' corner,
-    a singular point, falls with the mesh (35, 25 kN/m²) as the thesis law's first debonding
-    does. Until the jump the interface has only a process zone: no point fully debonded."""
+    both), while the onset of damage at the bearings' corner, a singular point, falls with the
+    mesh (35, 25 kN/m²) as the thesis law's first debonding does. Until the jump the interface
+    has only a process zone: no point fully debonded."""
     coarse = _cohesive_slab()
     fine = _cohesive_slab({"nx = 8\nny = 6": "nx = 16\nny = 12"})
     (c0, c1), (f0, f1) = _limit(coarse), _limit(fine)

@@ -683,8 +683,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         f_itf0 = interface_forces(problem, u)[0] if itf_form else None  # the start's (committed) state
         b0 = (balance_terms(problem, u) if arc and ps.energy_tolerance is not None and on_step_end is not None
               else None)  # the ledger at the start (energy_control)
-        # the ledger's dissipation at the start (CONSTRAINT_BOOKED)
-        # the ledger at the start (all dissipation, by damage): CONSTRAINT_BOOKED, unloading
+        # the interfaces' ledger at the start (all dissipation, by damage): CONSTRAINT_BOOKED, unloading
         ledger0 = (ledger_booked(problem)
                    if on_step_end is not None and hasattr(problem.interfaces, "dissipation") else None)
         while True:
@@ -739,9 +738,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # the constraint takes the stored energy to be the secant one; where the structure
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
                 # elastic path meets it without damage - the prescribed opening of the DCB on 100
-                # elements 'converged' from δ = 6.2 mm back to 0 in one increment. The interfaces' own ledger must book the dissipation (displacement paths; on force
-                # paths it also refused the unloading of the lap shear with friction past its peak,
-                # which `unloading` below stops with a clearer message)
+                # elements 'converged' from δ = 6.2 mm back to 0 in one increment. The interfaces'
+                # own ledger must book the dissipation (displacement paths only: on force paths it
+                # also refused the lap shear with friction's unloading past its peak, which
+                # `unloading` below stops with a clearer message)
                 if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
                     ok, msg = False, "the dissipation constraint was met by closure, not damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
@@ -830,8 +830,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                                    None if conj is None else (reaction, conj[1]))
         st.dissipated += dG
         # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
-        dD = (ledger_booked(problem)[1] - ledger0[1]
-              if ledger0 is not None and problem.interfaces.cohesive() else None)
+        damage = ledger_booked(problem)[1] if ledger0 is not None and problem.interfaces.cohesive() else None
+        dD = damage - ledger0[1] if damage is not None else None
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
@@ -878,7 +878,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                            or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
                                                st.dissipated, ps.end_fraction))
             if dD is not None and not displacement_path:
-                if dD > 1e-9 * max(ledger_booked(problem)[1], 1e-300):
+                if dD > 1e-9 * max(damage, 1e-300):
                     st.lam_damaged = lam
                 elif not st.finished and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak):
                     raise ConvergenceError(
@@ -934,12 +934,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
 #: back to the dissipation constraint
 ELASTIC_INCREMENT = 1e-6
 
+
 def ledger_booked(problem: Problem) -> tuple[float, float]:
     """The energy the cohesive interfaces' ledger has booked as dissipated so far: in all
     (fracture, viscous, friction), and by damage alone (fracture and its viscous regularisation,
     not friction)."""
-    damage = float(sum(problem.interfaces.dissipation()))
-    return damage + problem.interfaces.friction_dissipated(), damage
+    return problem.interfaces.dissipated_total(), float(sum(problem.interfaces.dissipation()))
 
 
 #: under displacement control by arc length, a dissipation-controlled increment whose interfaces
@@ -1027,9 +1027,8 @@ def unloading(lam: float, dlam: float, work_rate: float, lam_damaged: float, lam
     damage follows elastic or frictional unloading, an equilibrium path but not the structure's
     response to its load: the cohesive soffit slab (docs/performance.md, with a release rule not
     kept) went from λ = 278 to 0 so (its friction met the dissipation constraint) and ended as
-    'complete failure' with 1.5 % of its
-    interface debonded. (Past an elastic limit point, buckling, the load falls while the
-    displacement grows: not unloading.)"""
+    'complete failure' with 1.5 % of its interface debonded. (Past an elastic limit point,
+    buckling, the load falls while the displacement grows: not unloading.)"""
     return (dlam < 0 and work_rate < 0 and lam_peak > 0 and math.isfinite(lam_damaged)
             and lam < lam_damaged - UNLOADING_FRACTION * lam_peak)
 

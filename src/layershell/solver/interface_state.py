@@ -574,14 +574,16 @@ class InterfaceController:
         """Whether any interface has the cohesive law."""
         return any(isinstance(r, CohesiveRun) for r in self.runs)
 
-    def friction_dissipated(self) -> float:
-        """The energy friction on the cohesive interfaces' damaged share has dissipated so far."""
-        return sum(float(r.energy[1]) for r in self.runs if isinstance(r, CohesiveRun))
-
     def dissipation(self) -> tuple[float, float]:
         """(fracture, viscous): the energy the cohesive interfaces have dissipated so far."""
         coh = [r for r in self.runs if isinstance(r, CohesiveRun)]
         return sum(float(r.energy[0]) for r in coh), sum(float(r.energy[2]) for r in coh)
+
+    def dissipated_total(self) -> float:
+        """Fracture + friction + viscous: all the energy the cohesive interfaces' ledger has
+        booked as dissipated so far (the arc length's dissipation constraint measures the same
+        from the work, :func:`~layershell.solver.arclength.dissipation_increment`)."""
+        return sum(float(r.energy[0] + r.energy[1] + r.energy[2]) for r in self.runs if isinstance(r, CohesiveRun))
 
     # ------------------------------------------------------------------ results
     def first_failure(self) -> float | None:
