@@ -15,6 +15,7 @@ The last line is one JSON record (``cohesive_slab {...}``).
 from __future__ import annotations
 
 import json
+import re
 import sys
 import time
 from pathlib import Path
@@ -46,6 +47,9 @@ def study(mesh: str, to: float = 100.0, relax: bool = False, arc: bool = False) 
             "debonded_end": last["probes"].get("debonded"),
             "relaxations": [{k: v.get(k) for k in ("load_factor", "debonded_fraction_before", "debonded_fraction_after",
                                                    "energy_released")} for v in s.get("relaxations", [])],
+            # where load control stops: the load factor of the last converged (bisected) increment
+            "limit": (float(m.group(1)) if (m := re.search(r"the last converged load factor is ([0-9.]+)", r.message))
+                      else None),
             "message": r.message[:160], "wall_s": round(time.perf_counter() - t0, 1)}
 
 
@@ -60,7 +64,7 @@ def main(argv: list[str]) -> None:
               f"{r['last_load_factor']:.6g} | {r['peak_load_factor']} | {r['first_delamination']} | {r['debonded_end']} | "
               f"{r['wall_s']} |")
         if not r["converged"]:
-            print(f"  stopped: {r['message']}")
+            print(f"  stopped: {r['message']}" + (f" - last converged load factor {r['limit']}" if r["limit"] else ""))
         for x in r["relaxations"]:
             print(f"  relaxed at λ = {x['load_factor']:.6g}: debonded {x['debonded_fraction_before']:.3f} -> "
                   f"{x['debonded_fraction_after']:.3f}, released {x['energy_released']:.4g}")

@@ -87,11 +87,11 @@ def _jsonable(obj):
 
 
 #: the summary entries a checkpoint carries to the restarted run: what the run found up to it
-#: (the stabilisation, the relaxed jumps and the solver's counters included - a restart once
-#: dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
+#: (the stabilisation, the relaxed jumps, the stability events and the solver's counters included -
+#: a restart once dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
 SUMMARY_KEYS = ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end",
                 "stabilized", "relaxations", "active_set", "linear_solves", "energy_balance_warned",
-                "peak_load_factor", "contact_moved_to_nodes")
+                "peak_load_factor", "contact_moved_to_nodes", "stability")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,

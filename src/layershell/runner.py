@@ -174,16 +174,25 @@ class _ProbeFloors:
     all free DOFs, does not bound - and no engineer reads a jump in it."""
 
     RELATIVE = 1e-6
+    # a displacement probe below this share of the state's largest face translation is round-off
+    # (the lateral deflection of a perfect column compressed along its axis: 1e-16 against a
+    # shortening of 1e-3 is no jump however its noise changes; stability.py)
+    DISPLACEMENT = 1e-9
 
     def __init__(self, spec: RunSpec, problem: Problem):
         self.spec, self.problem = spec, problem
         self.norms: dict[str, float] = {}
+        dofs = np.concatenate([ld[:, 0, :].ravel() for ld in problem.dm.layer_dofs])
+        self.translations = dofs[dofs >= 0]  # the face translations u_0 of every layer
 
-    def __call__(self) -> dict[str, float]:
+    def __call__(self, u: np.ndarray | None = None) -> dict[str, float]:
         pb, spec = self.problem, self.spec
         scale = float(getattr(pb, "force_scale", 0.0)) * spec.newton.tol_residual
         out = {}
+        largest = float(np.abs(u[self.translations]).max(initial=0.0)) if u is not None else 0.0
         for p in spec.probes:
+            if p.quantity == "displacement" and u is not None:
+                out[p.name] = abs(p.scale) * self.DISPLACEMENT * largest
             if p.quantity != "reaction":
                 continue
             if p.name not in self.norms:
@@ -329,7 +338,8 @@ class _JumpWatch:
         probe_scales(self.scales, probes)
         if msgs is None:  # fixed steps: checked here (arc length and adaptive steps check, and cut, themselves)
             msgs = jump_warnings(st.step, st.load_factor, self.lam, frac, self.frac, probes, self.probes,
-                                 self.area, self.ratio, self.scales, self.floors() if self.floors is not None else None)
+                                 self.area, self.ratio, self.scales,
+                                 self.floors(st.u) if self.floors is not None else None)
         for m in msgs:
             _w.warn(m, JumpWarning, stacklevel=2)
         if msgs:
@@ -343,6 +353,40 @@ class CohesiveWarning(UserWarning):
 
 class JumpWarning(UserWarning):
     """A step with a jump of the debonded area or of a probe."""
+
+
+class StabilityWarning(UserWarning):
+    """The tangent stiffness gained negative eigenvalues without a limit point (stability.py)."""
+
+
+def _stability(summary: dict, events, log, locate: Callable | None = None) -> None:
+    """summary['stability'] gets the changes of the tangent's negative eigenvalues (stability.py);
+    bifurcations and an unstable start are warnings. An event of a step already recorded (a
+    restarted run replays its history) is skipped. ``locate(event)``: a bisection of a
+    bifurcation's load factors, (λ_lo, λ_hi) or None."""
+    seen = {e["step"] for e in summary.get("stability", [])}
+    for ev in events:
+        if ev.step in seen:
+            continue
+        if ev.kind == "bifurcation" and locate is not None:
+            ev.located = locate(ev)
+        summary.setdefault("stability", []).append(ev.as_dict())
+        if ev.warns:
+            _warn(summary, ev.message(), StabilityWarning, log)
+
+
+def _last_inertia(problem: Problem, u: np.ndarray, summary: dict, spec: RunSpec) -> int | None:
+    """The negative eigenvalues of the tangent at the last converged state: from the first solve
+    of the step that failed, else (a finished run) one factorisation at ``u`` - only without
+    interface laws, whose tangent at a committed state depends on the loading sets that the
+    path's solves freeze (None then, and where unknown)."""
+    if summary.get("failure") is not None:
+        from .solver.newton import start_inertia
+
+        return start_inertia(problem)
+    if not summary["steps"] or problem.interfaces is not None or not spec.model.nonlinear:
+        return None
+    return problem.inertia_at(u, spec.newton.backend)
 
 
 class ContactRuleWarning(UserWarning):
@@ -568,6 +612,30 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
 
     if progress is not None and step0:
         progress(step0, n_steps, lam0)
+    from .stability import StabilityWatch
+
+    # the load factor only grows under load control (fixed or adaptive steps)
+    # not with cohesive interfaces: there the tangent's inertia depends on which points the
+    # solves freeze as loading (every one at its threshold: Hill's comparison solid), and on the
+    # ENF it separated neither branch (docs/user-guide.md, ENF); a warning from it would be wrong
+    # on every softening run or never given
+    stab = (StabilityWatch(monotone=spec.path_following is None or spec.path_following.control != "arc_length")
+            if ctl is None or not ctl.cohesive() else None)
+    at_state = {"prev": (0, 0.0)}  # (step, λ) of the last converged state, whose inertia the next step brings
+    # the states of the last steps, from which a bifurcation is located by bisection: only where a
+    # state is a function of λ (no interface laws; geometrically nonlinear)
+    recent: dict[int, np.ndarray] = {}
+    bisect = stab is not None and ctl is None and model.nonlinear
+    if bisect:
+        recent[step0] = u.copy()
+
+    def locate(ev):
+        from .solver.newton import locate_inertia_change
+
+        if ev.step_before not in recent:
+            return None
+        return locate_inertia_change(problem, spec.newton, recent[ev.step_before], ev.load_factor_before,
+                                     ev.negative_eigenvalues_before, ev.load_factor)
     try:
         cut = None
         if ctl is not None and ctl.settings.max_debond_fraction is not None:
@@ -580,6 +648,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         if spec.path_following is not None:  # arc length / adaptive steps (solver/arclength.py)
             steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None, floors)
         jumps = _JumpWatch(spec, summary, ctl, floors)
+        for r in summary["steps"] if stab is not None else ():  # a restart: the history's states (events recorded)
+            stab.add(*at_state["prev"], r.get("negative_eigenvalues_at_start"))
+            at_state["prev"] = (r["step"], float(r["load_factor"]))
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u
@@ -587,6 +658,16 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                         for p in spec.probes}
                 rec = {"step": st.step, "load_factor": st.load_factor, "iterations": st.iterations,
                        "bisections": st.bisections, "wall_seconds": round(st.wall_seconds, 4), "probes": vals}
+                if stab is not None:  # the inertia of the tangent at the previous converged state (stability.py)
+                    if st.negative_eigenvalues_start is not None:
+                        rec["negative_eigenvalues_at_start"] = int(st.negative_eigenvalues_start)
+                    _stability(summary, stab.add(*at_state["prev"], st.negative_eigenvalues_start), log,
+                               locate if bisect else None)
+                    at_state["prev"] = (st.step, float(st.load_factor))
+                    if bisect:
+                        recent[st.step] = u.copy()
+                        for k in [k for k in recent if k < st.step - 3]:
+                            del recent[k]
                 from .interfaces import traction_summary
 
                 itf = traction_summary(model, problem.dm, u)
@@ -683,6 +764,11 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     finally:
         problem.monitor = None
     with _sigint_deferred(reraise=False):  # the run stops anyway: finish writing
+        if stab is not None:
+            if pending is None and not interrupted:
+                _stability(summary, stab.add(*at_state["prev"], _last_inertia(problem, u, summary, spec)), log,
+                           locate if bisect else None)
+            _stability(summary, stab.finish(), log, locate if bisect else None)
         if rcd is not None:
             if message or pending is not None:
                 log(f"stopped: {summary.get('error')}")

@@ -43,7 +43,7 @@ from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
                      active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, contact_hint,
                      contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze, newton, reaction_scale,
-                     record_scale, relax, resolve, stabilise, stagnates)
+                     record_scale, relax, resolve, stabilise, stagnates, start_inertia, note_start_inertia)
 from .problem import Problem
 
 
@@ -366,10 +366,12 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     att = Attempt(False, u0, lam0, 0)
     try:
         _, Kr = asm.evaluate_reduced(u0, op, forces=False)
+        serial_before = problem.tangent_inertia()[0]
         dut = solver.solve(Kr, q)
     except linear.SingularSystemError as exc:
         att.message = f"singular tangent ({exc})"
         return _unfrozen(att, blocks)
+    note_start_inertia(problem, serial_before)  # the tangent at the committed state (stability.py)
     dUt = op.expand(dut)  # the full-space predictor per unit λ
     if g is not None:
         dUt = dUt + g
@@ -628,14 +630,14 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                measure: Callable[[Problem], float] | None = None,
                watch: Callable[[np.ndarray, float], dict[str, float]] | None = None,
                max_resolves: int = 200,
-               floors: Callable[[], dict[str, float]] | None = None) -> Iterator[StepResult]:
+               floors: Callable[[np.ndarray], dict[str, float]] | None = None) -> Iterator[StepResult]:
     """Converged increments along the equilibrium path (see the module docstring); each
     :class:`StepResult` carries ``state`` (a :class:`PathState`) and ``warnings``. Ends at
     λ = ``lambda_end`` (load control, or arc length on a rising branch: the last increment is a
     load-controlled one to λ_end exactly), when λ falls below ``end_fraction`` of its peak
     (complete failure), or after
     ``max_steps`` increments. ``watch(u, λ)``: the probe values that the jump check watches;
-    ``floors()``: their noise floors at the current state (:func:`jump_warnings`)."""
+    ``floors(u)``: their noise floors at the state u (:func:`jump_warnings`)."""
     check_path(problem, ps)
     u = np.zeros(problem.dm.n_full) if u0 is None else u0.copy()
     lam = lam0
@@ -674,6 +676,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     reaction: float | None = None  # R = gᵀ f_int at the committed state (displacement paths; conjugates)
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
+        problem.start_inertia = None  # the increment's first solve, at u, sets it (note_start_inertia)
         total_it, cuts, resolves = 0, 0, 0
         e0 = dissipation_so_far(problem)
         residuals: list[float] = []
@@ -752,7 +755,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 ok, msg = False, "the dissipation constraint crossed λ = 0 (closure, not damage)"
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
-                                 scales, floors() if floors is not None else None):
+                                 scales, floors(att.u) if floors is not None else None):
                     ok, msg = False, "probe jump"
             if ok and b0 is not None and st.mode != "load":  # under load (displacement) control a node row
                 # that releases within a step is a jump of the path, which shorter steps do not resolve
@@ -835,7 +838,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
-                               probe_scales(scales, probes), floors() if floors is not None else None)
+                               probe_scales(scales, probes), floors(att.u) if floors is not None else None)
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)
@@ -907,7 +910,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         elif n == ps.max_steps:
             st.finished, end_reason = True, "max_steps"
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
-        res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0)
+        res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
+                         start_inertia(problem))
         res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
                               st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed,
                               st.last_increment, st.last_iterations)
@@ -1077,5 +1081,7 @@ def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -
 def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: PathSettings) -> float:
     """‖w ∘ δu_r‖ (:func:`arc_weights`) of the linear predictor for the load increment ``ps.increment``."""
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op, forces=False)
+    serial_before = problem.tangent_inertia()[0]
     dut = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, problem.op.reduce(load_rate(problem, u)))
+    note_start_inertia(problem, serial_before)
     return abs(ps.increment) * float(np.linalg.norm(dut * arc_weights(problem)))

@@ -94,6 +94,51 @@ class StepResult:
     residuals: list[float]
     bisections: int
     wall_seconds: float
+    # negative eigenvalues of the tangent at the state the step started from (the previous
+    # converged state; PARDISO's inertia of the step's first solve), None where that solve was no
+    # symmetric factorisation (GMRES on a kept one, or friction); stability.py
+    negative_eigenvalues_start: int | None = None
+
+
+def note_start_inertia(problem: Problem, serial_before: int) -> None:
+    """After the first solve of a load step or increment, at the state it started from: keep
+    the inertia of its tangent (``Problem.start_inertia``) where that solve factorised it
+    (the factorisation's serial grew past ``serial_before``); later solves of the step leave it."""
+    serial, negative = problem.tangent_inertia()
+    if problem.start_inertia is None and serial > serial_before:
+        problem.start_inertia = (serial, negative)
+
+
+def start_inertia(problem: Problem) -> int | None:
+    """The negative eigenvalues of the tangent at the start of the current step (None: unknown)."""
+    return problem.start_inertia[1] if problem.start_inertia is not None else None
+
+
+def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, lam_a: float, negative_a: int,
+                          lam_b: float, rel_tol: float = 1e-4, max_solves: int = 30) -> tuple[float, float]:
+    """Narrow the load factors between which the tangent's count of negative eigenvalues leaves
+    ``negative_a`` (its value at the converged state ``u_a`` at ``lam_a``; a different count at
+    ``lam_b``) by bisection: equilibrium at the midpoint by Newton from the last state below it,
+    then the inertia of the tangent there (one factorisation, :meth:`Problem.inertia_at`), until
+    the interval is ``rel_tol`` of |λ| or a solve fails. Only for models whose state is a function
+    of λ (no interface laws: nothing to commit), so that a state may be solved again; returns
+    (λ_lo, λ_hi), the bracket (stability.py)."""
+    lo, hi, u_lo = float(lam_a), float(lam_b), u_a
+    for _ in range(max_solves):
+        if abs(hi - lo) <= rel_tol * max(abs(hi), abs(lo), 1e-300):
+            break
+        mid = 0.5 * (lo + hi)
+        u_mid, res = newton(problem, u_lo, mid, s)
+        if not res.converged:
+            break
+        n = problem.inertia_at(u_mid, s.backend)
+        if n is None:
+            break
+        if n == negative_a:
+            lo, u_lo = mid, u_mid
+        else:
+            hi = mid
+    return lo, hi
 
 
 class ConvergenceError(RuntimeError):
@@ -479,11 +524,14 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
         _, Kr = asm.evaluate_reduced(u, op, forces=False)
+        serial_before = problem.tangent_inertia()[0]
         try:
             du = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, r)
         except linear.SingularSystemError as exc:
             res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
             return u, res
+        if it == 0:  # the tangent at the state this solve started from (stability.py)
+            note_start_inertia(problem, serial_before)
         dU = op.expand(du)
         en = abs(float(du @ r))
         e0 = en if e0 is None else e0
@@ -619,6 +667,7 @@ def load_steps(
 
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
+        problem.start_inertia = None  # the first solve of the step sets it (note_start_inertia)
         total_it, bis, cuts, halved = 0, 0, 0, 0
         e0 = dissipation_so_far(problem)
         residuals: list[float] = []
@@ -695,7 +744,8 @@ def load_steps(
                     raise reequilibration_error(problem, n, lam, res)
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         prev_target = target
-        yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0)
+        yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0,
+                         start_inertia(problem))
 
 
 # relax(): pseudo-time of the first increment (in units of the unit viscous time η = 1), its

@@ -37,6 +37,9 @@ class Problem:
     accepted_sets: int = 0
     accepted_violation: float = 0.0
     solve_counts_before: dict = field(default_factory=dict, repr=False)  # of the run before a restart
+    # (serial, negative eigenvalues) of the tangent factorised at the state the current step
+    # started from (solver/newton.py note_start_inertia; stability.py); None: not yet known
+    start_inertia: tuple | None = field(default=None, repr=False)
     # the bond flags the constraint operator was built from (rebuild_constraints)
     op_bonded: dict = field(default_factory=dict, repr=False)
 
@@ -77,6 +80,27 @@ class Problem:
             # tangents that are not fall back to the general mode
             self.solvers[key] = LinearSolver(backend, symmetric=True, decisions=self.orderings, reuse=reuse)
         return self.solvers[key]
+
+    def tangent_inertia(self) -> tuple[int, int | None]:
+        """(serial, negative eigenvalues) of the latest factorisation of this problem's tangent
+        (solver/linear.py FactorInfo; serial 0 before the first): the inertia is known from
+        PARDISO's symmetric mode only, else None."""
+        last = max((sol.info for sol in self.solvers.values()), key=lambda i: i.serial, default=None)
+        return (0, None) if last is None else (last.serial, last.negative_pivots)
+
+    def inertia_at(self, u: np.ndarray, backend: str = "auto") -> int | None:
+        """The negative eigenvalues of the reduced tangent at ``u`` (one assembly and one
+        factorisation, by a solver that keeps no factorisation); None where the tangent is not
+        symmetric or PARDISO is missing (stability.py: the last state of a run, bisections)."""
+        from .linear import SingularSystemError
+
+        _, Kr = self.assembler.evaluate_reduced(u, self.op, forces=False)
+        sol = self.linear_solver(backend, "never")  # always factorises (kept: its symbolic analysis)
+        try:
+            sol.solve(Kr, np.zeros(Kr.shape[0]))
+        except SingularSystemError:
+            return None
+        return sol.info.negative_pivots
 
     def solve_counts(self) -> dict:
         """Factorisations and GMRES solves of this problem's linear solvers (summary.json), with
