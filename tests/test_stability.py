@@ -12,62 +12,39 @@ import warnings
 import numpy as np
 import pytest
 
+from helpers import EXAMPLES
 from layershell.io.build import build, parse
 from layershell.runner import StabilityWarning, run
 from layershell.stability import StabilityWatch
 from test_path_following import _strip
 
-E, L, B, T = 1000.0, 100.0, 10.0, 1.0  # N, mm
+E, L, B, T = 1000.0, 100.0, 10.0, 1.0  # N, mm: examples/column_buckling.toml
 P_EULER = math.pi**2 * E * B * T**3 / 12 / (4 * L**2)  # first buckling load of the cantilever (λ = 1)
 
-COLUMN = """
-[model]
-title = "perfect cantilever column"
-nonlinear = true
-[mesh]
-type = "rectangle"
-lx = {L}
-ly = {B}
-nx = {nx}
-ny = 1
-[materials.m]
-type = "isotropic"
-E = {E}
-nu = 0.0
-[[layers]]
-name = "column"
-material = "m"
-thickness = {T}
-directors = 2
-[[supports]]
-type = "fix"
-where = "near(x, 0)"
-directors = "all"
-components = ["x", "y", "z"]
-[[loads]]
-type = "edge"
-where = "near(x, {L})"
-direction = [-1, 0, 0]
-distribution = {q!r}
-[steps]
-{steps}
-[[probes]]
-name = "w_tip"
-quantity = "displacement"
-point = [{L}, 0, 0]
-component = "z"
-"""
+
+def column_text(nx: int, steps: str) -> str:
+    """examples/column_buckling.toml (the perfect column: the axial edge load uniform through the
+    thickness, so that no moment acts and it stays straight) with ``nx`` elements and the
+    [steps] given (λ = 1: Euler's first load)."""
+    text = (EXAMPLES / "column_buckling.toml").read_text()
+    for a, b in (("nx = 8\n", f"nx = {nx}\n"), ("[steps]\nn = 10\nlambda_end = 10.0\n", f"[steps]\n{steps}\n")):
+        assert a in text
+        text = text.replace(a, b)
+    return text
 
 
 def column(nx: int, steps: str) -> dict:
-    """The perfect column (axial edge load uniform through the thickness, so that no moment
-    acts: it stays straight) run to the load factors of ``steps`` (λ = 1: Euler's first load)."""
-    text = COLUMN.format(L=L, B=B, T=T, E=E, nx=nx, q=P_EULER / (B * T), steps=steps)
+    """The summary of the perfect column run to the load factors of ``steps``."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        r = run(build(parse(text)), None, write_vtu=False)
+        r = run(build(parse(column_text(nx, steps))), None, write_vtu=False)
     assert r.converged, r.message
     return r.summary
+
+
+def test_example_matches_its_data():
+    """The example's load is Euler's P_E spread over the end section (λ = 1)."""
+    assert f"distribution = {P_EULER / (B * T)!r}" in (EXAMPLES / "column_buckling.toml").read_text()
 
 
 def test_watch_classifies_changes_of_the_count():
@@ -186,7 +163,7 @@ def test_stable_run_reports_no_event():
 
 def test_stability_warning_category():
     """The bifurcation is a StabilityWarning on the console (filterable by category)."""
-    text = COLUMN.format(L=L, B=B, T=T, E=E, nx=2, q=P_EULER / (B * T), steps="factors = [0.5, 1.5]")
+    text = column_text(2, "factors = [0.5, 1.5]")
     with pytest.warns(StabilityWarning, match="bifurcation point"):
         run(build(parse(text)), None, write_vtu=False)
 
@@ -194,8 +171,7 @@ def test_stability_warning_category():
 def test_restart_neither_repeats_nor_loses_an_event(tmp_path):
     """Interrupted after step 3 (its first bifurcation recorded) and restarted from the
     checkpoint: the same two located events as the uninterrupted run, none twice."""
-    text = COLUMN.format(L=L, B=B, T=T, E=E, nx=4, q=P_EULER / (B * T), steps="n = 10\nlambda_end = 10.0")
-    spec = build(parse(text))
+    spec = build(parse(column_text(4, "n = 10\nlambda_end = 10.0")))
 
     def stop_after_3(step, n, lam):
         if step == 3:
@@ -208,3 +184,84 @@ def test_restart_neither_repeats_nor_loses_an_event(tmp_path):
         assert part.interrupted and [e["step"] for e in part.summary["stability"]] == [1]
         again = run(spec, tmp_path / "part", restart=tmp_path / "part", write_vtu=False).summary["stability"]
     assert [(e["kind"], e["step"], e["located"]) for e in again] == [(e["kind"], e["step"], e["located"]) for e in whole]
+
+
+def elastica_deflection(ratio: float) -> float:
+    """The lateral tip deflection of the inextensible cantilever elastica at P = ratio × P_E
+    (Timoshenko & Gere §2.7): P / P_E = (2 K(k) / π)², δ / L = 2 k / K(k), K the complete
+    elliptic integral of the first kind of modulus k = sin(α/2), α the tip rotation."""
+    from scipy.optimize import brentq
+    from scipy.special import ellipk
+
+    K = math.pi / 2 * math.sqrt(ratio)
+    m = brentq(lambda m: ellipk(m) - K, 0.0, 1.0 - 1e-12)  # scipy's ellipk takes m = k²
+    return 2 * math.sqrt(m) / K * L
+
+
+def imperfect_column(nx: int, factors, eps: float = 1e-4, steps: str = "", converged: bool = True):
+    """The column with a lateral tip load eps × P_E (the imperfection) at the load factors given
+    (``steps``: more [steps] settings); its summary, or (with ``converged=False``) the RunResult."""
+    text = column_text(nx, "factors = [" + ", ".join(f"{f:.4f}" for f in factors) + "]" + steps)
+    text += f"""
+[[loads]]
+type = "edge"
+where = "near(x, {L})"
+direction = [0, 0, 1]
+distribution = {eps * P_EULER / (B * T)!r}
+"""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        r = run(build(parse(text)), None, write_vtu=False)
+    if not converged:
+        return r
+    assert r.converged, r.message
+    return r.summary
+
+
+def test_imperfect_column_follows_the_stable_elastica_on_three_meshes():
+    """With a lateral tip load of 10⁻⁴ P_E and load steps of 0.01 past the buckling load, the
+    column takes the buckled branch: every state is stable (no negative eigenvalue, no
+    stability event), and the tip deflection at 1.1, 1.2 and 1.5 P_E (where it is 79 % of the
+    length) converges with the mesh to within 1 % of the elastica: measured −1.9 / −0.9 / +0.1 %
+    on 4 elements, +0.4 / +0.5 / +0.7 % on 8 and +0.5 / +0.5 / +0.7 % on 16 (the imperfection,
+    shear and the axis's shortening, which the inextensible elastica lacks)."""
+    factors = np.r_[np.arange(0.1, 0.951, 0.05), np.arange(0.96, 1.2001, 0.01), 1.3, 1.4, 1.5]
+    at = (1.1, 1.2, 1.5)
+    ratios = []
+    for nx in (4, 8, 16):
+        s = imperfect_column(nx, factors)
+        assert "stability" not in s, s["stability"]
+        assert all(r["negative_eigenvalues_at_start"] == 0 for r in s["steps"])
+        w = {round(r["load_factor"], 4): r["probes"]["w_tip"] for r in s["steps"]}
+        ratios.append(np.array([w[lam] / elastica_deflection(lam) for lam in at]))
+    assert np.all(np.abs(ratios[0] - 1) < 0.02), ratios
+    assert np.all(np.abs(ratios[1] - 1) < 0.01) and np.all(np.abs(ratios[2] - 1) < 0.01), ratios
+    assert np.all(np.abs(ratios[2] - ratios[1]) < np.abs(ratios[1] - ratios[0])), ratios
+
+
+def test_load_step_across_the_buckling_load_of_an_imperfect_column_is_warned():
+    """The column with a smaller imperfection (10⁻⁵ P_E) and one load step from 0.99 to 1.01 P_E
+    (with 10⁻⁴ P_E the same steps find the buckled branch): Newton converges on
+    the unstable branch that deflects against the imperfection (w_tip −0.08 mm, against +18 mm
+    on the elastica) and stays there to 1.5 P_E. Each of these states has one negative eigenvalue:
+    the run warns that the equilibria are unstable (the located bracket is missing where the
+    bisection's first midpoint, near the buckling load, does not converge)."""
+    s = imperfect_column(8, [0.5, 0.9, 0.99, 1.01, 1.1, 1.5], eps=1e-5)
+    ev = s["stability"]
+    assert [e["kind"] for e in ev] == ["bifurcation"], ev
+    assert (ev[0]["load_factor_before"], ev[0]["load_factor"]) == (0.99, 1.01)
+    assert [r["negative_eigenvalues_at_start"] for r in s["steps"]] == [0, 0, 0, 0, 1, 1]
+    assert all(r["probes"]["w_tip"] < 0 for r in s["steps"][3:])
+    assert "located" not in ev[0]
+    assert any("unstable" in m and "jumped onto an unstable branch" in m for m in s["warnings"])
+
+
+def test_a_run_that_stops_on_an_unstable_state_says_so():
+    """Load control that fails from an unstable equilibrium (the imperfect column on its unstable
+    branch at 1.01 P_E, the next step to 5 P_E given 8 iterations and no bisection): the stop's
+    message names the negative eigenvalue of the tangent at the last converged state."""
+    r = imperfect_column(8, [0.5, 0.9, 0.99, 1.01, 5.0], eps=1e-5,
+                         steps="\nmax_iterations = 8\nmax_bisections = 0", converged=False)
+    assert not r.converged and r.summary["steps"][-1]["load_factor"] == pytest.approx(1.01)
+    assert "the tangent at the last converged state (load factor 1.01) has 1 negative eigenvalue(s)" in r.message
+    assert [e["kind"] for e in r.summary["stability"]] == ["bifurcation"]

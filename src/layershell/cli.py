@@ -291,8 +291,9 @@ def run(
     if failure is not None:
         _fail(*failure)
     numeric = [w for w in caught if issubclass(w.category, RuntimeWarning)]
+    notes = set(res.summary.get("warnings", []))  # the run's own warnings: printed once, below
     for w in caught:  # other warnings as usual
-        if not issubclass(w.category, RuntimeWarning):
+        if not issubclass(w.category, RuntimeWarning) and str(w.message) not in notes:
             warnings.showwarning(w.message, w.category, w.filename, w.lineno)
     if numeric and res.converged:  # a failed run explains itself; a converged one may hold NaN values
         first = " ".join(str(numeric[0].message).split())

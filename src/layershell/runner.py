@@ -16,7 +16,7 @@ from . import checkpoint
 from .io.build import RunSpec
 from .recorder import Recorder, read_history
 from .solver.arclength import ENERGY_WARN, probe_scales
-from .solver.newton import ConvergenceError, DebondCut, load_steps
+from .solver.newton import ConvergenceError, DebondCut, load_steps, start_inertia
 from .solver.problem import Problem
 from .threads import openblas_single_thread
 
@@ -381,8 +381,6 @@ def _last_inertia(problem: Problem, u: np.ndarray, summary: dict, spec: RunSpec)
     interface laws, whose tangent at a committed state depends on the loading sets that the
     path's solves freeze (None then, and where unknown)."""
     if summary.get("failure") is not None:
-        from .solver.newton import start_inertia
-
         return start_inertia(problem)
     if not summary["steps"] or problem.interfaces is not None or not spec.model.nonlinear:
         return None
@@ -745,6 +743,12 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         message = str(exc)
         if "residual" not in message and np.isfinite(exc.residual):
             message += f" (last residual {exc.residual:.3e})"
+        negative = start_inertia(problem) if stab is not None else None
+        if negative:  # the failed step's first solve factorised the tangent at the last converged state
+            lam_last = summary["steps"][-1]["load_factor"] if summary["steps"] else lam0
+            message += (f"; the tangent at the last converged state (load factor {lam_last:.6g}) has {negative} "
+                        "negative eigenvalue(s): that equilibrium is unstable - the structure passed a buckling "
+                        "(bifurcation) or limit point before it (summary.json 'stability')")
         summary["error"] = message
         summary["failure"] = failure
     except KeyboardInterrupt as exc:

@@ -64,15 +64,16 @@ class StabilityEvent:
                     "the first state recorded: the equilibrium is unstable from the start (a structure loaded "
                     "beyond its buckling load in one step, or a mechanism held by a penalty only); use smaller "
                     "steps to see where the eigenvalue(s) turn negative")
-        where = ("; bisection locates the bifurcation between load factors "
+        where = ("; bisection locates the change between load factors "
                  f"{self.located[0]:.7g} and {self.located[1]:.7g}" if self.located is not None
                  else "; smaller steps locate it")
         return (f"step {self.step}: the tangent stiffness has {n} negative eigenvalue(s) at load factor {lam:.6g} "
                 f"against {self.negative_eigenvalues_before} at {self.load_factor_before:.6g} (step "
-                f"{self.step_before}), and the load factor did not pass a maximum in between: the path went "
-                "through a bifurcation point (e.g. buckling), and the states from here on are unstable equilibria "
-                "that a perfect model can stay on; a small imperfection in the buckling mode (a load or a "
-                f"geometric deviation) makes the model follow the other branch{where}")
+                f"{self.step_before}), and the load factor did not pass a maximum in between: the equilibria from "
+                "here on are unstable. The path went through a bifurcation point (e.g. buckling), on which a "
+                "perfect model can stay, or a load step jumped onto an unstable branch. Smaller steps or "
+                "control = 'arc_length' follow a path without jumps, and a small imperfection in the buckling "
+                f"mode (a load or a geometric deviation) makes the model take the stable branch{where}")
 
 
 def _turns(lams: list[float]) -> int:

@@ -115,14 +115,15 @@ def start_inertia(problem: Problem) -> int | None:
 
 
 def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, lam_a: float, negative_a: int,
-                          lam_b: float, rel_tol: float = 1e-4, max_solves: int = 30) -> tuple[float, float]:
+                          lam_b: float, rel_tol: float = 1e-4, max_solves: int = 30) -> tuple[float, float] | None:
     """Narrow the load factors between which the tangent's count of negative eigenvalues leaves
     ``negative_a`` (its value at the converged state ``u_a`` at ``lam_a``; a different count at
     ``lam_b``) by bisection: equilibrium at the midpoint by Newton from the last state below it,
     then the inertia of the tangent there (one factorisation, :meth:`Problem.inertia_at`), until
     the interval is ``rel_tol`` of |λ| or a solve fails. Only for models whose state is a function
     of λ (no interface laws: nothing to commit), so that a state may be solved again; returns
-    (λ_lo, λ_hi), the bracket (stability.py)."""
+    (λ_lo, λ_hi), the narrowed bracket, or None where not even the first midpoint was solved
+    (an imperfect structure near its buckling load; stability.py)."""
     lo, hi, u_lo = float(lam_a), float(lam_b), u_a
     for _ in range(max_solves):
         if abs(hi - lo) <= rel_tol * max(abs(hi), abs(lo), 1e-300):
@@ -138,7 +139,7 @@ def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, 
             lo, u_lo = mid, u_mid
         else:
             hi = mid
-    return lo, hi
+    return (lo, hi) if (lo, hi) != (float(lam_a), float(lam_b)) else None
 
 
 class ConvergenceError(RuntimeError):
