@@ -265,3 +265,28 @@ def test_a_run_that_stops_on_an_unstable_state_says_so():
     assert not r.converged and r.summary["steps"][-1]["load_factor"] == pytest.approx(1.01)
     assert "the tangent at the last converged state (load factor 1.01) has 1 negative eigenvalue(s)" in r.message
     assert [e["kind"] for e in r.summary["stability"]] == ["bifurcation"]
+
+
+def test_buckling_modes_are_written_and_match_the_euler_shapes(tmp_path):
+    """With a results folder each located bifurcation's mode (the tangent's eigenvector nearest
+    zero just below it) is written as buckling_mode_<step>.vtu and named in the event and the
+    warning. On 8 elements the lateral deflection along the column matches the cantilever's
+    Euler modes 1 − cos((2k − 1) π x / 2L) (shear does not change the shape of a uniform column):
+    MAC above 0.9999 for both."""
+    import meshio
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        s = run(build(parse(column_text(8, "n = 10\nlambda_end = 10.0"))), tmp_path, write_vtu=False).summary
+    files = [e["mode_file"] for e in s["stability"]]
+    assert files == ["buckling_mode_0001.vtu", "buckling_mode_0009.vtu"]
+    assert sum(f"its mode: {f}" in m for f in files for m in s["warnings"]) == 2
+    for k, f in enumerate(files, start=1):
+        m = meshio.read(tmp_path / f)
+        x = m.points[:, 0]
+        w = m.point_data["displacement"][:, 2]
+        exact = 1 - np.cos((2 * k - 1) * np.pi * x / (2 * L))
+        mac = (w @ exact) ** 2 / ((w @ w) * (exact @ exact))
+        assert mac > 0.9999, (k, mac)
+        assert np.abs(m.point_data["displacement"]).max() == pytest.approx(1.0)
+    assert set(files) <= set((tmp_path / ".layershell-files").read_text().split())

@@ -369,7 +369,7 @@ def _stability(summary: dict, events, log, locate: Callable | None = None) -> No
         if ev.step in seen:
             continue
         if ev.kind == "bifurcation" and locate is not None:
-            ev.located = locate(ev)
+            ev.located, ev.mode_file = locate(ev)
         summary.setdefault("stability", []).append(ev.as_dict())
         if ev.warns:
             _warn(summary, ev.message(), StabilityWarning, log)
@@ -628,12 +628,27 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         recent[step0] = u.copy()
 
     def locate(ev):
-        from .solver.newton import locate_inertia_change
+        """(λ_lo, λ_hi) of a bifurcation by bisection, and the file of its buckling mode (the
+        eigenvector of the tangent just below it, written with the results) - or None."""
+        from .solver.newton import critical_mode, locate_inertia_change
 
         if ev.step_before not in recent:
-            return None
-        return locate_inertia_change(problem, spec.newton, recent[ev.step_before], ev.load_factor_before,
-                                     ev.negative_eigenvalues_before, ev.load_factor)
+            return None, None
+        found = locate_inertia_change(problem, spec.newton, recent[ev.step_before], ev.load_factor_before,
+                                      ev.negative_eigenvalues_before, ev.load_factor)
+        if found is None:
+            return None, None
+        lo, hi, u_lo = found
+        name = None
+        if rcd is not None:
+            phi = critical_mode(problem, u_lo)
+            if phi is not None:
+                from .export import _write_vtu, surface_mesh
+
+                name = f"buckling_mode_{ev.step:04d}.vtu"
+                _write_vtu(rcd.path(name), surface_mesh(model, problem.dm, phi))
+                rcd.register([name])
+        return (lo, hi), name
     try:
         cut = None
         if ctl is not None and ctl.settings.max_debond_fraction is not None:

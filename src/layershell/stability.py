@@ -42,6 +42,7 @@ class StabilityEvent:
     negative_eigenvalues_before: int
     # a bifurcation located by bisection (solver/newton.py locate_inertia_change): (λ_lo, λ_hi)
     located: tuple[float, float] | None = None
+    mode_file: str | None = None  # its buckling mode (runner: buckling_mode_<step>.vtu)
 
     def as_dict(self) -> dict:
         d = asdict(self)
@@ -49,6 +50,8 @@ class StabilityEvent:
             d.pop("located")
         else:
             d["located"] = [float(v) for v in self.located]
+        if self.mode_file is None:
+            d.pop("mode_file")
         return d
 
     @property
@@ -67,6 +70,8 @@ class StabilityEvent:
         where = ("; bisection locates the change between load factors "
                  f"{self.located[0]:.7g} and {self.located[1]:.7g}" if self.located is not None
                  else "; smaller steps locate it")
+        if self.mode_file is not None:
+            where += f" (its mode: {self.mode_file})"
         return (f"step {self.step}: the tangent stiffness has {n} negative eigenvalue(s) at load factor {lam:.6g} "
                 f"against {self.negative_eigenvalues_before} at {self.load_factor_before:.6g} (step "
                 f"{self.step_before}), and the load factor did not pass a maximum in between: the equilibria from "

@@ -115,15 +115,17 @@ def start_inertia(problem: Problem) -> int | None:
 
 
 def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, lam_a: float, negative_a: int,
-                          lam_b: float, rel_tol: float = 1e-4, max_solves: int = 30) -> tuple[float, float] | None:
+                          lam_b: float, rel_tol: float = 1e-4,
+                          max_solves: int = 30) -> tuple[float, float, np.ndarray] | None:
     """Narrow the load factors between which the tangent's count of negative eigenvalues leaves
     ``negative_a`` (its value at the converged state ``u_a`` at ``lam_a``; a different count at
     ``lam_b``) by bisection: equilibrium at the midpoint by Newton from the last state below it,
     then the inertia of the tangent there (one factorisation, :meth:`Problem.inertia_at`), until
     the interval is ``rel_tol`` of |λ| or a solve fails. Only for models whose state is a function
     of λ (no interface laws: nothing to commit), so that a state may be solved again; returns
-    (λ_lo, λ_hi), the narrowed bracket, or None where not even the first midpoint was solved
-    (an imperfect structure near its buckling load; stability.py)."""
+    (λ_lo, λ_hi, u_lo), the narrowed bracket and the state at its lower end, or None where not
+    even the first midpoint was solved (an imperfect structure near its buckling load;
+    stability.py)."""
     lo, hi, u_lo = float(lam_a), float(lam_b), u_a
     for _ in range(max_solves):
         if abs(hi - lo) <= rel_tol * max(abs(hi), abs(lo), 1e-300):
@@ -139,7 +141,30 @@ def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, 
             lo, u_lo = mid, u_mid
         else:
             hi = mid
-    return (lo, hi) if (lo, hi) != (float(lam_a), float(lam_b)) else None
+    return (lo, hi, u_lo) if (lo, hi) != (float(lam_a), float(lam_b)) else None
+
+
+def critical_mode(problem: Problem, u: np.ndarray) -> np.ndarray | None:
+    """The eigenvector of the reduced tangent at ``u`` whose eigenvalue lies nearest zero (SciPy's
+    shift-invert Lanczos, σ = 0), expanded to the full DOFs and scaled to a largest face
+    translation of 1: at a state just below a located bifurcation, its buckling mode. None where
+    the tangent is not symmetric or the eigensolver fails."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    _, Kr = problem.assembler.evaluate_reduced(u, problem.op, forces=False)
+    K = sp.csc_matrix(Kr)
+    if K.shape[0] < 2 or not linear.is_symmetric(K):
+        return None
+    try:
+        _, vec = spla.eigsh(K, k=1, sigma=0.0, which="LM")
+    except (RuntimeError, spla.ArpackError, spla.ArpackNoConvergence):
+        return None
+    phi = problem.op.expand(vec[:, 0])
+    dofs = np.concatenate([ld[:, 0, :].ravel() for ld in problem.dm.layer_dofs])
+    dofs = dofs[dofs >= 0]
+    big = dofs[np.argmax(np.abs(phi[dofs]))]
+    return phi / phi[big] if phi[big] != 0 else None
 
 
 class ConvergenceError(RuntimeError):
