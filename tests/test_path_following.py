@@ -698,3 +698,55 @@ def test_load_column_of_prescribed_displacements_is_the_tangent_times_g(nonlinea
     err = np.abs(stiffness_along(pb, u, g) - Kg).max() / np.abs(Kg).max()
     assert err < (1e-7 if not nonlinear else 1e-5), err
     assert np.allclose(load_rate(pb, u), pb.F_scaled - stiffness_along(pb, u, g), rtol=0, atol=1e-12 * np.abs(Kg).max())
+
+
+def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypatch):
+    """Where the arc length's increments fail at their smallest size (or crawl), one
+    load-controlled increment is tried from the last state (Newton with its own active-set loop);
+    where it converges the run warns and goes on by arc length, where it does not (here beyond
+    λ = 0.5, as past a peak; its cuts cannot reach 0.5 exactly) the run stops with the arc length's message and says that a
+    load-controlled increment found no equilibrium either. Stand-ins: constrained iterations that
+    never converge, and a Newton solve with equilibria up to λ = 0.5 only."""
+    from types import SimpleNamespace
+
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import ConvergenceError, NewtonResult, NewtonSettings
+
+    def never(problem, u, lam, size, *a, **k):
+        return al.Attempt(False, u, lam, 3, [1.0], message="stand-in: no constrained solution")
+
+    def newton_to_half(problem, u, lam, s):
+        ok = lam <= 0.5 + 1e-12
+        return u + 1.0, NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
+
+    for name, value in (("arc_attempt", never), ("newton", newton_to_half), ("check_path", lambda p, ps: None),
+                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
+                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
+                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None)):
+        monkeypatch.setattr(al, name, value)
+    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None)
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, dissipation=False)
+    seen = []
+    with pytest.raises(ConvergenceError) as err:
+        for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.1, u0=np.zeros(2)):
+            seen.append((st.load_factor, st.warnings))
+    assert [lam for lam, _ in seen] == pytest.approx([0.35, 0.475])  # 0.1 + 0.25, then + 0.125 (one cut)
+    assert all(any("one load-controlled increment passed it" in w for w in ws) for _, ws in seen)
+    msg = str(err.value)
+    assert msg.startswith("step 3: no equilibrium from load factor 0.475")
+    assert "a load-controlled increment from it found no equilibrium either" in msg
+    ps.load_rescue = False  # without the rescue the first failure stops the run
+    with pytest.raises(ConvergenceError) as err:
+        list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.1, u0=np.zeros(2)))
+    assert "either" not in str(err.value) and "from load factor 0.1" in str(err.value)
+    # a rescue may not jump: where the load-controlled increment converges only with a probe jump
+    # at every size (a snap-back passed dynamically), the run stops and says so
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         max_jump_cuts=2, jump_area=None, jump_ratio=3.0, dissipation=False)
+    seen = []
+    with pytest.raises(ConvergenceError) as err:
+        for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.1, u0=np.zeros(2),
+                                watch=lambda u, lam: {"p": 1.0 if lam <= 0.36 else 100.0}):
+            seen.append(st.load_factor)
+    assert seen == pytest.approx([0.35]) and "a load-controlled increment from it jumps (probe jump" in str(err.value)

@@ -167,3 +167,24 @@ def test_cohesive_soffit_end_debonding_load_converges_with_the_mesh():
     assert fine.summary["first_delamination_load_factor"] is None
     d_c, d_f = coarse.summary["first_damage_load_factor"], fine.summary["first_damage_load_factor"]
     assert d_f < d_c < 0.2 * c0  # the onset at the singular corner falls, far below the debonding
+
+
+@pytest.mark.slow
+def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
+    """By arc length (8 × 6) the frozen-set constrained iterations crawl at 277.5 kN/m² and fail
+    again at 321.7 and near the peak; at each, one load-controlled increment (Newton with its own
+    active-set loop) passes the state, warned, and the arc length goes on. The path reaches the
+    end-debonding peak of load control (measured 327.12 against 327.13 kN/m², test above) and
+    stops on the snap-back just past it, naming the crawl or failure and that a load-controlled
+    increment found no equilibrium either, or only one after a jump (a rescue may not jump: once
+    one converged past the snap-back with half of the interface debonding in one increment, as
+    `unstable = "relax"` does but without booking the released energy, and the path went on to
+    376.6 kN/m²). (Before the rescue the run stopped at 277.5 kN/m², 15 % below the peak;
+    docs/performance.md.)"""
+    r = _cohesive_slab({"n = 20\n": 'n = 80\ncontrol = "arc_length"\nmax_steps = 3000\n',
+                        "lambda_end = 100.0": "lambda_end = 400.0"})
+    s = r.summary
+    assert not r.converged and "a load-controlled increment from it" in r.message
+    assert s["peak_load_factor"] == pytest.approx(327.13, rel=1e-3)
+    assert s["steps"][-1]["load_factor"] < s["peak_load_factor"]  # on the snap-back, past the peak
+    assert any("one load-controlled increment passed it" in w for w in s["warnings"])

@@ -75,6 +75,9 @@ class PathSettings:
     # ... or when, past the peak and below STALL_FRACTION of it, λ has changed by less than
     # end_fraction × its peak over this many increments (the path stalls: complete failure)
     stall_increments: int = 25
+    # a stuck arc length (a crawl, or an increment failing at its smallest size) tries one
+    # load-controlled increment (λ + increment, halved on failure) before it stops
+    load_rescue: bool = True
     max_cuts: int = 12
     max_jump_cuts: int = 5  # a jump that persists after this many halvings is accepted (with a warning)
     # NewtonSettings.unstable = "relax", load control: relax at the load of the increment after
@@ -674,6 +677,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     # (no reaction) to λ_end, under the arc length again (below)
     displacement_path = arc and prescribed_direction(problem) is not None
     reaction: float | None = None  # R = gᵀ f_int at the committed state (displacement paths; conjugates)
+    rescue: str | None = None  # a crawl's stop message while one load-controlled increment tries to pass it
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.start_inertia = None  # the increment's first solve, at u, sets it (note_start_inertia)
@@ -803,6 +807,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     st.size = size0  # the jump is behind: the size before the cuts, halved below
                     break
             if limit:
+                if jump and rescue is not None:  # a load-controlled rescue may not jump a snap-back
+                    raise ConvergenceError(
+                        rescue + f"; a load-controlled increment from it jumps ({msg} at every size down to "
+                        f"Δλ = {st.size:.3g}): the path snaps back there. Load control with [steps] unstable = "
+                        "'relax' passes the jump at a fixed load and reports the energy it releases",
+                        lam, residuals[-1] if residuals else float("nan"))
                 if jump:
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
                     continue
@@ -818,10 +828,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
                     cuts, st.size = 0, size0  # as load_steps: the thesis's contact at the nodes from here on
                     continue
-                raise ConvergenceError(f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step "
-                                       f"cuts ({msg}); the last converged load factor is {lam:.6g}"
-                                       + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem),
-                                       lam, residuals[-1] if residuals else float("nan"))
+                if rescue is not None:  # the load-controlled increment did not pass either
+                    raise ConvergenceError(rescue + f"; a load-controlled increment from it found no equilibrium "
+                                           f"either ({msg})", lam, residuals[-1] if residuals else float("nan"))
+                stop = (f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step cuts ({msg}); the "
+                        f"last converged load factor is {lam:.6g}"
+                        + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem))
+                if st.mode != "load" and _may_rescue(ps, arc, lam):
+                    rescue, st.mode, st.size, cuts = stop, "load", _rescue_increment(ps, lam), 0  # see the crawl below
+                    continue
+                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
             st.size *= 0.5
         # accepted increment
         du = att.u - u
@@ -869,6 +885,13 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # nothing left to dissipate (the interface has separated, the reaction vanished):
                 # the prescribed displacement goes on elastically, by the arc length
                 st.mode, st.size = "arc", st.arc_length
+        if rescue is not None:  # the load-controlled increment passed the crawl: the arc length again
+            warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
+                         f"crawled or found no equilibrium); one load-controlled increment passed it to "
+                         f"{att.lam:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
+                         "had no solution)")
+            st.mode, st.size, rescue = "arc", st.arc_length, None
+            resolves += 1  # the next increment's direction by the work criterion (st.changed)
         st.du_prev = du
         st.changed = resolves > 0
         u, lam = att.u, att.lam
@@ -921,15 +944,32 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         yield res
         if st.finished:
             return
-        if crawl:  # after the step is kept: the path cannot go on from it
-            raise ConvergenceError(
-                f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
-                f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
-                f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
-                f"dissipated so far; the constrained iterations fail at every larger increment. The last converged state "
-                f"is kept. Where the path is expected to rise to the design load, load control (control = 'load') with "
-                f"[steps] stabilize passes such a state; else refine the mesh at the debonding front",
-                lam, residuals[-1] if residuals else float("nan"))
+        if crawl:  # after the step is kept: the path cannot go on from it by the arc length
+            stop = (f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
+                    f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
+                    f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
+                    f"dissipated so far; the constrained iterations fail at every larger increment. The last converged "
+                    f"state is kept. Where the path is expected to rise to the design load, load control "
+                    f"(control = 'load') with [steps] stabilize passes such a state; else refine the mesh at the "
+                    f"debonding front")
+            if not _may_rescue(ps, arc, lam):
+                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
+            # one load-controlled increment (Newton with its own active-set loop, which passes states
+            # where the constrained iterations on frozen sets have no solution), as long as λ rises
+            rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)
+            recent, recent_dG = [], []
+
+
+def _may_rescue(ps: PathSettings, arc: bool, lam: float) -> bool:
+    """May a stuck arc length (a crawl, or an increment that fails at its smallest size) try one
+    load-controlled increment? ``PathSettings.load_rescue`` (on; not a model-file key), arc-length
+    control, a positive load factor (the increment raises it)."""
+    return ps.load_rescue and arc and lam > 0.0
+
+
+def _rescue_increment(ps: PathSettings, lam: float) -> float:
+    """The first Δλ of a load-controlled rescue: the run's first increment (its cuts halve it)."""
+    return max(ps.increment, abs(lam) * ps.end_fraction)
 
 
 #: under displacement control by arc length, a dissipation-controlled increment that dissipated
