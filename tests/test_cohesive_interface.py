@@ -561,7 +561,7 @@ def _stand_in_problem(viscous_per_step: float = 0.01):
     from types import SimpleNamespace
 
     return SimpleNamespace(interfaces=_StandInInterfaces(viscous_per_step), dm=SimpleNamespace(n_full=2),
-                           F_scaled=np.zeros(2))
+                           F_scaled=np.zeros(2), begin_step=lambda: None, start_inertia=None)
 
 
 def _newton_without_equilibrium_past_half(problem, u, lam, s):

@@ -724,7 +724,8 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
                         ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
                         ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None)):
         monkeypatch.setattr(al, name, value)
-    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None)
+    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, dissipation=False)
     seen = []

@@ -101,7 +101,8 @@ def test_without_relaxation_the_step_stops_with_a_hint():
         ok = lam <= 0.5 + 1e-12
         return u, nw.NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "the set cycles")
 
-    pb = SimpleNamespace(interfaces=SimpleNamespace(cohesive=lambda: True), dm=SimpleNamespace(n_full=2))
+    pb = SimpleNamespace(interfaces=SimpleNamespace(cohesive=lambda: True), dm=SimpleNamespace(n_full=2),
+                         begin_step=lambda: None, start_inertia=None)
     import unittest.mock as um
 
     with um.patch.object(nw, "newton", no_equilibrium_past_half):

@@ -17,6 +17,11 @@ class DofMap:
     layer_dofs: list[np.ndarray]
     present: np.ndarray  # (n_layers, n_nodes) bool
 
+    def translations(self) -> np.ndarray:
+        """The full-space DOFs of the face translations u_0 of every layer (director 0)."""
+        dofs = np.concatenate([ld[:, 0, :].ravel() for ld in self.layer_dofs])
+        return dofs[dofs >= 0]
+
     def element_dofs(self, model: Model, layer: int, elements: np.ndarray) -> np.ndarray:
         """(e, 9*(d+1)*3) DOFs of ``layer`` for ``elements`` (kernel order)."""
         d = self.layer_dofs[layer][model.mesh.elements[elements]]

@@ -182,8 +182,7 @@ class _ProbeFloors:
     def __init__(self, spec: RunSpec, problem: Problem):
         self.spec, self.problem = spec, problem
         self.norms: dict[str, float] = {}
-        dofs = np.concatenate([ld[:, 0, :].ravel() for ld in problem.dm.layer_dofs])
-        self.translations = dofs[dofs >= 0]  # the face translations u_0 of every layer
+        self.translations = problem.dm.translations()
 
     def __call__(self, u: np.ndarray | None = None) -> dict[str, float]:
         pb, spec = self.problem, self.spec

@@ -293,6 +293,17 @@ class DistributedProblem:
     snapshot = Problem.snapshot
     restore = Problem.restore
     prescribed = Problem.prescribed
+    # the stability check (stability.py) reads the inertia of each step's first factorisation;
+    # PETSc's KSP reports none, so it stays unknown on distributed runs
+    start_inertia = None
+    start_open = False
+
+    def begin_step(self) -> None:
+        """A load step or path increment starts (Problem.begin_step): nothing to keep here."""
+
+    def solve_tangent(self, Kr, r: np.ndarray, backend: str = "auto", reuse: str = "auto") -> np.ndarray:
+        """K_r x = r by the KSP (Problem.solve_tangent, without the inertia)."""
+        return self.linear_solver(backend, reuse).solve(Kr, r)
 
     def rebuild_constraints(self) -> None:
         """T stays: cohesive interfaces never change the bond state (a thesis-law release would

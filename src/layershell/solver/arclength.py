@@ -43,7 +43,7 @@ from . import linear
 from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
                      active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, contact_hint,
                      contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze, newton, reaction_scale,
-                     record_scale, relax, resolve, stabilise, stagnates, start_inertia, note_start_inertia)
+                     record_scale, relax, resolve, stabilise, stagnates, start_inertia)
 from .problem import Problem
 
 
@@ -369,12 +369,10 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     att = Attempt(False, u0, lam0, 0)
     try:
         _, Kr = asm.evaluate_reduced(u0, op, forces=False)
-        serial_before = problem.tangent_inertia()[0]
-        dut = solver.solve(Kr, q)
+        dut = problem.solve_tangent(Kr, q, s.backend, s.reuse_factorization)  # at the committed state
     except linear.SingularSystemError as exc:
         att.message = f"singular tangent ({exc})"
         return _unfrozen(att, blocks)
-    note_start_inertia(problem, serial_before)  # the tangent at the committed state (stability.py)
     dUt = op.expand(dut)  # the full-space predictor per unit λ
     if g is not None:
         dUt = dUt + g
@@ -680,7 +678,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     rescue: str | None = None  # a crawl's stop message while one load-controlled increment tries to pass it
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
-        problem.start_inertia = None  # the increment's first solve, at u, sets it (note_start_inertia)
+        problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
         total_it, cuts, resolves = 0, 0, 0
         e0 = dissipation_so_far(problem)
         residuals: list[float] = []
@@ -885,15 +883,15 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # nothing left to dissipate (the interface has separated, the reaction vanished):
                 # the prescribed displacement goes on elastically, by the arc length
                 st.mode, st.size = "arc", st.arc_length
-        if rescue is not None:  # the load-controlled increment passed the crawl: the arc length again
+        rescued = rescue is not None
+        if rescued:  # the load-controlled increment passed the crawl: the arc length again
             warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
                          f"crawled or found no equilibrium); one load-controlled increment passed it to "
                          f"{att.lam:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
                          "had no solution)")
             st.mode, st.size, rescue = "arc", st.arc_length, None
-            resolves += 1  # the next increment's direction by the work criterion (st.changed)
         st.du_prev = du
-        st.changed = resolves > 0
+        st.changed = resolves > 0 or rescued  # the next direction by the work criterion
         u, lam = att.u, att.lam
         reaction = conj[1] if conj is not None else None
         st.lam_peak = max(st.lam_peak, abs(lam))
@@ -1121,7 +1119,5 @@ def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -
 def _first_arc_length(problem: Problem, u: np.ndarray, s: NewtonSettings, ps: PathSettings) -> float:
     """‖w ∘ δu_r‖ (:func:`arc_weights`) of the linear predictor for the load increment ``ps.increment``."""
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op, forces=False)
-    serial_before = problem.tangent_inertia()[0]
-    dut = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, problem.op.reduce(load_rate(problem, u)))
-    note_start_inertia(problem, serial_before)
+    dut = problem.solve_tangent(Kr, problem.op.reduce(load_rate(problem, u)), s.backend, s.reuse_factorization)
     return abs(ps.increment) * float(np.linalg.norm(dut * arc_weights(problem)))

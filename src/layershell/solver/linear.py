@@ -35,7 +35,6 @@ models (the DCB's strip: a factorisation costs 3-6 iterations) are always factor
 from __future__ import annotations
 
 import ctypes
-import itertools
 import math
 import zlib
 from dataclasses import dataclass
@@ -98,11 +97,6 @@ class FactorInfo:
     analysed: bool = False  # a new symbolic analysis was done (pattern changed)
     negative_pivots: int | None = None  # inertia: negative eigenvalues of the tangent (symmetric mode only)
     perturbed_pivots: int | None = None
-    serial: int = 0  # numbers the factorisations of a process (which one is the latest)
-
-
-# numbers every factorisation (FactorInfo.serial): Problem.tangent_inertia takes the latest
-_FACTORISATIONS = itertools.count(1)
 
 
 # GMRES on a kept factorisation (LinearSolver ``reuse``)
@@ -394,8 +388,7 @@ class PardisoSymmetric:
         ip = self._s.iparm
         # PARDISO's inertia (iparm[22], negative eigenvalues; Bunch-Kaufman pivoting) exists in the
         # symmetric indefinite mode only
-        self.info = FactorInfo("pardiso", not same, int(ip[22]) if self.MTYPE == -2 else None, int(ip[13]),
-                               next(_FACTORISATIONS))
+        self.info = FactorInfo("pardiso", not same, int(ip[22]) if self.MTYPE == -2 else None, int(ip[13]))
         return x
 
     def release(self) -> None:
@@ -528,7 +521,7 @@ class LinearSolver:
                 raise SingularSystemError(str(exc)) from exc
             x = lu.solve(r)
             self.counts.factorisations += 1
-            self.info = FactorInfo("superlu", True, serial=next(_FACTORISATIONS))
+            self.info = FactorInfo("superlu", True)
         if not np.all(np.isfinite(x)):
             raise SingularSystemError("the solution of the linear system is not finite")
         # a singular tangent - an unsupported rigid-body motion - leaves a large residual; slender

@@ -100,18 +100,10 @@ class StepResult:
     negative_eigenvalues_start: int | None = None
 
 
-def note_start_inertia(problem: Problem, serial_before: int) -> None:
-    """After the first solve of a load step or increment, at the state it started from: keep
-    the inertia of its tangent (``Problem.start_inertia``) where that solve factorised it
-    (the factorisation's serial grew past ``serial_before``); later solves of the step leave it."""
-    serial, negative = problem.tangent_inertia()
-    if problem.start_inertia is None and serial > serial_before:
-        problem.start_inertia = (serial, negative)
-
-
 def start_inertia(problem: Problem) -> int | None:
-    """The negative eigenvalues of the tangent at the start of the current step (None: unknown)."""
-    return problem.start_inertia[1] if problem.start_inertia is not None else None
+    """The negative eigenvalues of the tangent at the start of the current step (None: unknown;
+    :meth:`Problem.solve_tangent`)."""
+    return problem.start_inertia
 
 
 def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, lam_a: float, negative_a: int,
@@ -161,8 +153,7 @@ def critical_mode(problem: Problem, u: np.ndarray) -> np.ndarray | None:
     except (RuntimeError, spla.ArpackError, spla.ArpackNoConvergence):
         return None
     phi = problem.op.expand(vec[:, 0])
-    dofs = np.concatenate([ld[:, 0, :].ravel() for ld in problem.dm.layer_dofs])
-    dofs = dofs[dofs >= 0]
+    dofs = problem.dm.translations()
     big = dofs[np.argmax(np.abs(phi[dofs]))]
     return phi / phi[big] if phi[big] != 0 else None
 
@@ -550,14 +541,11 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
         _, Kr = asm.evaluate_reduced(u, op, forces=False)
-        serial_before = problem.tangent_inertia()[0]
         try:
-            du = problem.linear_solver(s.backend, s.reuse_factorization).solve(Kr, r)
+            du = problem.solve_tangent(Kr, r, s.backend, s.reuse_factorization)
         except linear.SingularSystemError as exc:
             res.message = f"singular tangent ({exc}); check that supports prevent every rigid-body motion"
             return u, res
-        if it == 0:  # the tangent at the state this solve started from (stability.py)
-            note_start_inertia(problem, serial_before)
         dU = op.expand(du)
         en = abs(float(du @ r))
         e0 = en if e0 is None else e0
@@ -693,7 +681,7 @@ def load_steps(
 
     for n, target in enumerate(load_factors, start=step0 + 1):
         t0 = time.perf_counter()
-        problem.start_inertia = None  # the first solve of the step sets it (note_start_inertia)
+        problem.begin_step()  # its first solve keeps the inertia of the start's tangent (stability.py)
         total_it, bis, cuts, halved = 0, 0, 0, 0
         e0 = dissipation_so_far(problem)
         residuals: list[float] = []

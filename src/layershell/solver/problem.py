@@ -37,9 +37,11 @@ class Problem:
     accepted_sets: int = 0
     accepted_violation: float = 0.0
     solve_counts_before: dict = field(default_factory=dict, repr=False)  # of the run before a restart
-    # (serial, negative eigenvalues) of the tangent factorised at the state the current step
-    # started from (solver/newton.py note_start_inertia; stability.py); None: not yet known
-    start_inertia: tuple | None = field(default=None, repr=False)
+    # the negative eigenvalues of the tangent at the state the current step started from, kept by
+    # the step's first solve (solve_tangent; stability.py); None: unknown. ``start_open``: that
+    # first solve is still to come (begin_step)
+    start_inertia: int | None = field(default=None, repr=False)
+    start_open: bool = field(default=False, repr=False)
     # the bond flags the constraint operator was built from (rebuild_constraints)
     op_bonded: dict = field(default_factory=dict, repr=False)
 
@@ -81,12 +83,23 @@ class Problem:
             self.solvers[key] = LinearSolver(backend, symmetric=True, decisions=self.orderings, reuse=reuse)
         return self.solvers[key]
 
-    def tangent_inertia(self) -> tuple[int, int | None]:
-        """(serial, negative eigenvalues) of the latest factorisation of this problem's tangent
-        (solver/linear.py FactorInfo; serial 0 before the first): the inertia is known from
-        PARDISO's symmetric mode only, else None."""
-        last = max((sol.info for sol in self.solvers.values()), key=lambda i: i.serial, default=None)
-        return (0, None) if last is None else (last.serial, last.negative_pivots)
+    def begin_step(self) -> None:
+        """A load step or path increment starts: its first :meth:`solve_tangent`, at the state
+        it starts from, keeps the inertia of that state's tangent (``start_inertia``)."""
+        self.start_inertia, self.start_open = None, True
+
+    def solve_tangent(self, Kr, r: np.ndarray, backend: str = "auto", reuse: str = "auto") -> np.ndarray:
+        """K_r x = r by this problem's linear solver. The first solve of a step (begin_step) keeps
+        the negative eigenvalues of K_r where it factorised it (PARDISO's symmetric mode), None
+        where it did not (GMRES on a kept factorisation, a failed or non-symmetric solve)."""
+        sol = self.linear_solver(backend, reuse)
+        before = sol.counts.factorisations
+        try:
+            return sol.solve(Kr, r)
+        finally:
+            if self.start_open:
+                self.start_open = False
+                self.start_inertia = sol.info.negative_pivots if sol.counts.factorisations > before else None
 
     def inertia_at(self, u: np.ndarray, backend: str = "auto") -> int | None:
         """The negative eigenvalues of the reduced tangent at ``u`` (one assembly and one
