@@ -174,17 +174,39 @@ def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
     """By arc length (8 × 6) the frozen-set constrained iterations crawl at 277.5 kN/m² and fail
     again at 321.7 and near the peak; at each, one load-controlled increment (Newton with its own
     active-set loop) passes the state, warned, and the arc length goes on. The path reaches the
-    end-debonding peak of load control (measured 327.12 against 327.13 kN/m², test above) and
-    stops on the snap-back just past it, naming the crawl or failure and that a load-controlled
-    increment found no equilibrium either, or only one after a jump (a rescue may not jump: once
-    one converged past the snap-back with half of the interface debonding in one increment, as
-    `unstable = "relax"` does but without booking the released energy, and the path went on to
-    376.6 kN/m²). (Before the rescue the run stopped at 277.5 kN/m², 15 % below the peak;
-    docs/performance.md.)"""
+    end-debonding peak of load control (measured 327.12 against 327.13 kN/m², test above): the
+    largest load factor before a tenth of the interface debonds (at the snap-back half of it
+    debonds), with the energy balance held to 1 %.
+
+    Past the peak the route depends on round-off, near the peak the loading sets cycle (measured,
+    docs/performance.md): here the run stops just past the peak, naming the crawl and that a
+    load-controlled increment found no equilibrium either; with NumPy, BLAS, MKL and Numba held
+    to AVX2 the dissipation constraint traces the snap-back down to 305.7 kN/m² (balance 3e-5)
+    and the run stops where the arc length loses the debonding branch ("unloads without
+    damage"); on CI the path went on to the second peak at 376.6 kN/m², that of load control with
+    unstable = 'relax' (376.6-377.1). Either way no rescue may jump (a load-controlled increment
+    across the snap-back converges with half of the interface debonded at once, as 'relax' does
+    but without booking the released energy; tests/test_path_following.py), and a path past the
+    snap-back keeps the energy balance or is warned of the jump. (Before the rescue the run
+    stopped at 277.5 kN/m², 15 % below the peak.)"""
     r = _cohesive_slab({"n = 20\n": 'n = 80\ncontrol = "arc_length"\nmax_steps = 3000\n',
                         "lambda_end = 100.0": "lambda_end = 400.0"})
     s = r.summary
-    assert not r.converged and "a load-controlled increment from it" in r.message
-    assert s["peak_load_factor"] == pytest.approx(327.13, rel=1e-3)
-    assert s["steps"][-1]["load_factor"] < s["peak_load_factor"]  # on the snap-back, past the peak
     assert any("one load-controlled increment passed it" in w for w in s["warnings"])
+    area = [sum(st["debonded_area"].values()) for st in s["steps"]]
+    lam = [st["load_factor"] for st in s["steps"]]
+    balance = [abs(st["energy"]["balance_error"]) for st in s["steps"]]
+    intact = [i for i, a in enumerate(area) if a < 0.1 * 3.0]  # the quarter's interface: 3 m²
+    # the end-debonding peak, within 0.2 % (the 8 × 6 and 16 × 12 meshes differ by 0.5 %): near
+    # the peak the loading sets cycle, and where the path stops depends on round-off
+    assert max(lam[i] for i in intact) == pytest.approx(327.13, rel=2e-3)
+    assert max(balance[i] for i in intact) < 0.01
+    rescued = {int(m) for w in s["warnings"]
+               for m in re.findall(r"step (\d+): the arc length could not go on", w)}
+    jumps = {st["step"]: a - a0 for st, a, a0 in zip(s["steps"][1:], area[1:], area)}
+    assert rescued and all(jumps.get(n, 0.0) <= 0.2 * 3.0 for n in rescued)  # no rescue jumps (jump_area 0.2)
+    if len(intact) == len(lam):  # stopped at the snap-back, with a message that says why
+        assert not r.converged
+        assert "a load-controlled increment from it" in r.message or "unloads without damage" in r.message
+    else:  # passed the snap-back: traced (the balance holds) or warned
+        assert max(balance) < 0.01 or any("the debonded area jumped" in w for w in s["warnings"])

@@ -618,7 +618,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     # on every softening run or never given
     stab = (StabilityWatch(monotone=spec.path_following is None or spec.path_following.control != "arc_length")
             if ctl is None or not ctl.cohesive() else None)
-    at_state = {"prev": (0, 0.0)}  # (step, λ) of the last converged state, whose inertia the next step brings
+    prev_state = (0, 0.0)  # (step, λ) of the last converged state, whose inertia the next step brings
     # the states of the last steps, from which a bifurcation is located by bisection: only where a
     # state is a function of λ (no interface laws; geometrically nonlinear)
     recent: dict[int, np.ndarray] = {}
@@ -661,8 +661,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
             steps = _path_steps(spec, problem, u, lam0, step0, ck, on_step_end if ctl is not None else None, floors)
         jumps = _JumpWatch(spec, summary, ctl, floors)
         for r in summary["steps"] if stab is not None else ():  # a restart: the history's states (events recorded)
-            stab.add(*at_state["prev"], r.get("negative_eigenvalues_at_start"))
-            at_state["prev"] = (r["step"], float(r["load_factor"]))
+            stab.add(*prev_state, r.get("negative_eigenvalues_at_start"))
+            prev_state = (r["step"], float(r["load_factor"]))
         for st in steps:
             with _sigint_deferred():  # a step is recorded completely or not at all
                 u = st.u
@@ -673,9 +673,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                 if stab is not None:  # the inertia of the tangent at the previous converged state (stability.py)
                     if st.negative_eigenvalues_start is not None:
                         rec["negative_eigenvalues_at_start"] = int(st.negative_eigenvalues_start)
-                    _stability(summary, stab.add(*at_state["prev"], st.negative_eigenvalues_start), log,
+                    _stability(summary, stab.add(*prev_state, st.negative_eigenvalues_start), log,
                                locate if bisect else None)
-                    at_state["prev"] = (st.step, float(st.load_factor))
+                    prev_state = (st.step, float(st.load_factor))
                     if bisect:
                         recent[st.step] = u.copy()
                         for k in [k for k in recent if k < st.step - 3]:
@@ -784,7 +784,7 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     with _sigint_deferred(reraise=False):  # the run stops anyway: finish writing
         if stab is not None:
             if pending is None and not interrupted:
-                _stability(summary, stab.add(*at_state["prev"], _last_inertia(problem, u, summary, spec)), log,
+                _stability(summary, stab.add(*prev_state, _last_inertia(problem, u, summary, spec)), log,
                            locate if bisect else None)
             _stability(summary, stab.finish(), log, locate if bisect else None)
         if rcd is not None:

@@ -755,6 +755,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # through closure meets the constraint without any damage (the force-loaded DCB
                 # on 150 elements 'converged' from λ = 0.42 to -0.03 with its arms shut)
                 ok, msg = False, "the dissipation constraint crossed λ = 0 (closure, not damage)"
+            if (ok and rescue is not None and not allow_jump and measure is not None and ps.jump_area is not None
+                    and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
+                # a rescue's Newton solve updates the cohesive sets itself: a snap-back it passes
+                # (half of the slab's interface debonding at once, no re-solution to see it in)
+                # shows only in the converged increment's debonded area
+                ok, msg = False, "debonding jump"
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
                                  scales, floors(att.u) if floors is not None else None):
