@@ -770,3 +770,46 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
                                 measure=lambda p: 0.0 if last["lam"] <= 0.36 else 0.5):
             seen.append(st.load_factor)
     assert seen == pytest.approx([0.35]) and "a load-controlled increment from it jumps (debonding jump" in str(err.value)
+
+
+def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused(monkeypatch):
+    """On a force path a dissipation-controlled increment in which λ falls while the interfaces'
+    ledger books no damage is friction's work on unloading, not a snap-back: refused (cut, then
+    the arc length, which here rises). The cohesive slab on 16 × 12 fell from 180.8 to 168 kN/m²
+    so with its fracture energy flat to 10⁻⁷, while load control rises through 180 smoothly
+    (docs/performance.md). Stand-ins: the dissipation constraint converges with λ falling, the
+    arc length with λ rising, a ledger that books nothing (the same increment with damage booked
+    is accepted, falling)."""
+    from types import SimpleNamespace
+
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonSettings
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        return al.Attempt(True, u + 1e-3, lam - 0.01 if mode == "dissipation" else lam + 0.01, 3, [1e-10])
+
+    booked = {"damage": 0.0}
+    for name, value in (("arc_attempt", attempt), ("check_path", lambda p, ps: None),
+                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
+                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
+                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None),
+                        ("ledger_booked", lambda p: (booked["damage"], booked["damage"])),
+                        ("arc_weights", lambda p: 1.0)):
+        monkeypatch.setattr(al, name, value)
+    itf = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
+
+    def on_step_end(problem, u, lam):  # commits the state: damage booked where asked
+        booked["damage"] += damage_per_increment
+        return False
+
+    pb = SimpleNamespace(interfaces=itf, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None, snapshot=lambda: dict(booked), restore=booked.update,
+                         op=SimpleNamespace(independent=np.arange(2)))
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
+    for damage_per_increment, expected in ((0.0, 0.51), (1.0, 0.49)):
+        booked["damage"] = 0.0
+        st0 = al.PathState(mode="dissipation", size=0.1, arc_length=1.0, lam_peak=0.5, arc_length0=1.0)
+        steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                                   on_step_end=on_step_end))
+        assert [s.load_factor for s in steps] == pytest.approx([expected])

@@ -749,6 +749,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # `unloading` below stops with a clearer message)
                 if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
                     ok, msg = False, "the dissipation constraint was met by closure, not damage"
+            if (ok and ledger0 is not None and not displacement_path and st.mode == "dissipation"
+                    and att.lam < lam and problem.interfaces.cohesive()
+                    and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
+                # on a force path the same, where the load falls: friction's work on sliding
+                # points meets the constraint while the structure unloads (the cohesive slab on
+                # 16 × 12 fell from 180.8 to 168 kN/m² so, the fracture ledger flat to 10⁻⁷ while
+                # load control rises smoothly through 180 to 325; docs/performance.md). Refused,
+                # the increment is cut, then tried by the arc length, then by a load-controlled
+                # rescue; a snap-back books damage and is not refused
+                ok, msg = False, "the dissipation constraint was met by friction on unloading, not by damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
