@@ -69,6 +69,7 @@ def _run_and_signal(model: Path, out: Path, after_step: int, sig: int, extra=())
     the caller's checks."""
     env = dict(os.environ, NO_COLOR="1", COLUMNS="200", PYTHONIOENCODING="utf-8")
     env.pop("LAYERSHELL_TRACEBACK", None)
+
     def preexec():
         # a shell without job control starts background commands (`make test &`, nohup) with
         # SIGINT ignored, which the child would inherit: then Python installs no KeyboardInterrupt

@@ -739,26 +739,25 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
-            if ok and ledger0 is not None and displacement_path and st.mode == "dissipation":
+            if ok and ledger0 is not None and st.mode == "dissipation":
                 # the constraint takes the stored energy to be the secant one; where the structure
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
                 # elastic path meets it without damage - the prescribed opening of the DCB on 100
                 # elements 'converged' from δ = 6.2 mm back to 0 in one increment. The interfaces'
-                # own ledger must book the dissipation (displacement paths only: on force paths it
-                # also refused the lap shear with friction's unloading past its peak, which
-                # `unloading` below stops with a clearer message)
-                if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
-                    ok, msg = False, "the dissipation constraint was met by closure, not damage"
-            if (ok and ledger0 is not None and not displacement_path and st.mode == "dissipation"
-                    and att.lam < lam and problem.interfaces.cohesive()
-                    and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
-                # on a force path the same, where the load falls: friction's work on sliding
-                # points meets the constraint while the structure unloads (the cohesive slab on
-                # 16 × 12 fell from 180.8 to 168 kN/m² so, the fracture ledger flat to 10⁻⁷ while
-                # load control rises smoothly through 180 to 325; docs/performance.md). Refused,
-                # the increment is cut, then tried by the arc length, then by a load-controlled
-                # rescue; a snap-back books damage and is not refused
-                ok, msg = False, "the dissipation constraint was met by friction on unloading, not by damage"
+                # own ledger must book the dissipation. On displacement paths all of it counts; on
+                # force paths only damage, and only where the load falls (friction's work on
+                # sliding points met the constraint while the cohesive slab on 16 × 12 unloaded
+                # from 180.8 to 168 kN/m², its fracture ledger flat to 10⁻⁷, while load control
+                # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
+                # (Counting rising force increments too refused the lap shear with friction's
+                # unloading past its peak, which `unloading` below stops with a clearer message.)
+                # A refused increment is cut, then tried by the arc length, then by a rescue
+                if displacement_path:
+                    if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
+                        ok, msg = False, "the dissipation constraint was met by closure, not damage"
+                elif (att.lam < lam and problem.interfaces.cohesive()
+                      and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
+                    ok, msg = False, "the dissipation constraint was met by friction on unloading, not by damage"
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
