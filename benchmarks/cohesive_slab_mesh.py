@@ -50,6 +50,8 @@ def study(mesh: str, to: float = 100.0, relax: bool = False, arc: bool = False) 
             # where load control stops: the load factor of the last converged (bisected) increment
             "limit": (float(m.group(1)) if (m := re.search(r"the last converged load factor is ([0-9.]+)", r.message))
                       else None),
+            "increments": len(s["steps"]),
+            "balance": max((abs(st["energy"]["balance_error"]) for st in s["steps"] if "energy" in st), default=None),
             "message": r.message[:160], "wall_s": round(time.perf_counter() - t0, 1)}
 
 
@@ -57,12 +59,13 @@ def main(argv: list[str]) -> None:
     to = float(argv[argv.index("--to") + 1]) if "--to" in argv else 100.0
     meshes = [a for a in argv if "x" in a and a[0].isdigit()]
     rows = [study(m, to, "--relax" in argv, "--arc" in argv) for m in meshes or ["8x6"]]
-    print("| mesh | DOFs | first damage | w_mid(100) mm | fracture(100) | last λ | peak λ | first full debonding | debonded at end | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| mesh | DOFs | first damage | w_mid(100) mm | fracture(100) | last λ | peak λ | first full debonding | "
+          "debonded at end | increments | largest balance error | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['mesh']} | {r['dofs']} | {r['first_damage']} | {r['w_mid_100']} | {r['fracture_100']} | "
               f"{r['last_load_factor']:.6g} | {r['peak_load_factor']} | {r['first_delamination']} | {r['debonded_end']} | "
-              f"{r['wall_s']} |")
+              f"{r['increments']} | {'-' if r['balance'] is None else format(r['balance'], '.2g')} | {r['wall_s']} |")
         if not r["converged"]:
             print(f"  stopped: {r['message']}" + (f" - last converged load factor {r['limit']}" if r["limit"] else ""))
         for x in r["relaxations"]:

@@ -398,16 +398,25 @@ def test_increments_whose_iterations_do_not_depend_on_their_size_grow():
     shorter that took at most one fewer, says the count does not follow the size (then the next
     grows by INSENSITIVE_GROWTH, where the increment was cut below INSENSITIVE_BELOW of the
     first); not beyond twice the target, not without a last increment. The Gmsh plate that it
-    lets reach λ = 1: tests/test_delamination.py."""
+    lets reach λ = 1: tests/test_delamination.py. Under the arc length it compares with the last
+    two increments (arclength.ARC_WINDOW): the shortest and the most iterations of them."""
     from layershell.solver.arclength import size_insensitive
 
-    assert size_insensitive(1.2e-5, 8, 1e-5, 7, 8)  # longer, one iteration more
-    assert not size_insensitive(1.2e-5, 9, 1e-5, 7, 8)  # two more: the size matters
-    assert size_insensitive(0.8e-5, 7, 1e-5, 8, 8)  # shorter, one fewer: the cut did not pay
-    assert not size_insensitive(0.8e-5, 6, 1e-5, 8, 8)  # two fewer: it did
-    assert not size_insensitive(1.05e-5, 7, 1e-5, 7, 8)  # the size barely changed
-    assert not size_insensitive(2e-5, 17, 1e-5, 17, 8)  # more than twice the target
-    assert not size_insensitive(2e-5, 5, 0.0, 0, 8)  # the first increment
+    assert size_insensitive(1.2e-5, 8, [(1e-5, 7)], 8)  # longer, one iteration more
+    assert not size_insensitive(1.2e-5, 9, [(1e-5, 7)], 8)  # two more: the size matters
+    assert size_insensitive(0.8e-5, 7, [(1e-5, 8)], 8)  # shorter, one fewer: the cut did not pay
+    assert not size_insensitive(0.8e-5, 6, [(1e-5, 8)], 8)  # two fewer: it did
+    assert not size_insensitive(1.05e-5, 7, [(1e-5, 7)], 8)  # the size barely changed
+    assert not size_insensitive(2e-5, 17, [(1e-5, 17)], 8)  # more than twice the target
+    assert not size_insensitive(2e-5, 5, [(0.0, 0)], 8)  # the first increment
+    assert not size_insensitive(2e-5, 5, [], 8)
+    # the arc length's window of two: counts that alternate (the 16 x 12 slab: 9, 7, 9, ...)
+    # against the shortest and the most of the last two
+    assert not size_insensitive(1.02e-5, 9, [(0.89e-5, 7)], 8)  # against the last alone: +2
+    assert size_insensitive(1.02e-5, 9, [(1e-5, 9), (0.89e-5, 7)], 8)
+    assert not size_insensitive(1.02e-5, 11, [(1e-5, 9), (0.89e-5, 7)], 8)  # +2 on the most
+    assert size_insensitive(0.8e-5, 6, [(1e-5, 9), (0.95e-5, 7)], 8)  # shorter, one fewer than the fewest
+    assert not size_insensitive(0.8e-5, 5, [(1e-5, 9), (0.95e-5, 7)], 8)
 
 
 def test_jump_warnings_unit():
@@ -703,7 +712,8 @@ def test_load_column_of_prescribed_displacements_is_the_tangent_times_g(nonlinea
 def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypatch):
     """Where the arc length's increments fail at their smallest size (or crawl), one
     load-controlled increment is tried from the last state (Newton with its own active-set loop);
-    where it converges the run warns and goes on by arc length, where it does not (here beyond
+    where it converges the run warns and goes on by load-controlled increments (a stretch) until
+    one fails, then by arc length again; where it does not (here beyond
     λ = 0.5, as past a peak; its cuts cannot reach 0.5 exactly) the run stops with the arc length's message and says that a
     load-controlled increment found no equilibrium either. Stand-ins: constrained iterations that
     never converge, and a Newton solve with equilibria up to λ = 0.5 only."""
@@ -732,8 +742,14 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
     with pytest.raises(ConvergenceError) as err:
         for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.1, u0=np.zeros(2)):
             seen.append((st.load_factor, st.warnings))
-    assert [lam for lam, _ in seen] == pytest.approx([0.35, 0.475])  # 0.1 + 0.25, then + 0.125 (one cut)
-    assert all(any("one load-controlled increment passed it" in w for w in ws) for _, ws in seen)
+    # 0.1 + 0.25 by the rescue; then a stretch of load-controlled increments: + 0.5 and + 0.25
+    # fail (STRETCH_CUTS), so the arc length again, which fails, and a rescue from 0.35: + 0.25
+    # fails, + 0.125 passes; from 0.475 the stretch fails, the arc length, and the rescue too
+    assert [lam for lam, _ in seen] == pytest.approx([0.35, 0.475])
+    for _, ws in seen:
+        assert any("one load-controlled increment passed it" in w and "go on while they converge" in w for w in ws)
+    assert any("load-controlled increments took the path from load factor 0.1 to 0.35; from there the arc "
+               "length again" in w for w in seen[1][1])
     msg = str(err.value)
     assert msg.startswith("step 3: no equilibrium from load factor 0.475")
     assert "a load-controlled increment from it found no equilibrium either" in msg
@@ -770,6 +786,73 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
                                 measure=lambda p: 0.0 if last["lam"] <= 0.36 else 0.5):
             seen.append(st.load_factor)
     assert seen == pytest.approx([0.35]) and "a load-controlled increment from it jumps (debonding jump" in str(err.value)
+
+
+def test_a_rising_branch_on_which_the_arc_length_needs_cuts_is_taken_by_load_control(monkeypatch):
+    """On a force path, an arc-length increment that needed cuts and raised λ above its peak so
+    far hands over to load-controlled increments (a stretch: Newton with its own active-set loop
+    steps over the single points' local snap-backs that the arc length traces one by one; the
+    cohesive slab on 16 × 12 rose by 5-40 kN/m² per load-controlled increment where its arc
+    lengths advanced 0.04-0.5). The stretch ends after a load-controlled increment that needed a
+    halving, or where one fails within STRETCH_CUTS halvings (here above λ = 0.6, as at a peak):
+    the arc length again from the last state, and no new stretch until λ passes the load that
+    the failed increment aimed at.
+    Stand-ins: arc-length increments that converge up to Δl = 0.5 (λ + 0.05 each), a Newton
+    solve with equilibria up to λ = 0.6."""
+    from types import SimpleNamespace
+
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonResult, NewtonSettings
+
+    def arc_to_half(problem, u, lam, size, *a, **k):
+        ok = size <= 0.5 + 1e-12
+        return al.Attempt(ok, u + 0.1, lam + 0.05, 2, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
+
+    calls = []
+
+    def newton_to_06(problem, u, lam, s):
+        calls.append(lam)
+        ok = lam <= 0.6 + 1e-12
+        return u + 1.0, NewtonResult(ok, 8, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
+
+    for name, value in (("arc_attempt", arc_to_half), ("newton", newton_to_06), ("check_path", lambda p, ps: None),
+                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
+                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
+                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None),
+                        ("full_weights", lambda p: 1.0)):
+        monkeypatch.setattr(al, name, value)
+    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None)
+    ps = al.PathSettings(control="arc_length", lambda_end=10.0, increment=0.25, arc_length=1.0, max_cuts=4,
+                         jump_area=None, jump_ratio=None, dissipation=False)
+    steps = []
+    for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.1, u0=np.zeros(2)):
+        steps.append(st)
+        if len(steps) == 8:
+            break
+    lams = [st.load_factor for st in steps]
+    # the arc length (Δl 1 fails, 0.5 passes: a cut on a rising branch), then load control (8
+    # iterations: the size stays): + 0.25; + 0.25 fails and + 0.125 passes, which ends the stretch;
+    # the arc length, + 0.05 per increment, each after a cut from here
+    assert lams[:5] == pytest.approx([0.15, 0.4, 0.525, 0.575, 0.625])
+    assert [st.state.mode for st in steps] == ["load", "load", "arc", "arc", "arc", "arc", "load", "arc"]
+    assert any("from load factor 0.15" in w and "load-controlled increments go on" in w for w in steps[1].warnings)
+    assert any("load-controlled increments took the path from load factor 0.15 to 0.525" in w
+               for w in steps[2].warnings)
+    # a new stretch only above the load the halved increment left out (0.525 + 0.125), after an
+    # increment with a cut: from 0.725; its first increment fails at both sizes (0.975, 0.85): the
+    # arc length again, not warned
+    assert lams[5:] == pytest.approx([0.675, 0.725, 0.775])
+    tried = [lam for lam in calls if lam > 0.6]
+    assert tried == pytest.approx([0.65, 0.975, 0.85])
+    assert all(not any("took the path" in w for w in st.warnings) for st in steps[3:])
+    # not where λ falls, not below the peak, not below the block, not without cuts, not on a
+    # displacement path, not without the rescue
+    assert al.stretch_may_start(ps, True, False, 1, 0.5, 0.05, 0.45, -np.inf)
+    for args in ((True, False, 1, 0.5, -0.05, 0.45, -np.inf), (True, False, 1, 0.5, 0.05, 0.55, -np.inf),
+                 (True, False, 1, 0.5, 0.05, 0.45, 0.6), (True, False, 0, 0.5, 0.05, 0.45, -np.inf),
+                 (True, True, 1, 0.5, 0.05, 0.45, -np.inf), (False, False, 1, 0.5, 0.05, 0.45, -np.inf)):
+        assert not al.stretch_may_start(ps, *args), args
 
 
 def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused(monkeypatch):
@@ -813,3 +896,27 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
         steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
                                    on_step_end=on_step_end))
         assert [s.load_factor for s in steps] == pytest.approx([expected])
+        # the step's path state (what a checkpoint keeps) carries the last load with damage growth
+        assert steps[0].state.lam_damaged == pytest.approx(0.49) if damage_per_increment else np.isnan(
+            steps[0].state.lam_damaged)
+
+
+def test_the_path_state_survives_a_checkpoint_whole():
+    """Every field of arclength.PathState, set away from its default, comes back from the arrays
+    a checkpoint stores (the last load with damage growth and the arc length's recent increments
+    were the ones a restart could lose)."""
+    from dataclasses import fields
+
+    from layershell.solver import arclength as al
+
+    st = al.PathState(mode="arc", size=2e-4, arc_length=3e-4, du_prev=np.arange(3.0), lam_peak=2.5,
+                      dissipated=0.7, finished=True, arc_length0=1e-2, changed=True, last_increment=0.01,
+                      last_iterations=6, lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc")
+    assert all(getattr(st, f.name) != getattr(al.PathState(), f.name) for f in fields(st)
+               if f.name != "du_prev")
+    back = al.PathState.from_arrays(st.arrays())
+    for f in fields(st):
+        if f.name == "du_prev":
+            np.testing.assert_array_equal(back.du_prev, st.du_prev)
+        else:
+            assert getattr(back, f.name) == getattr(st, f.name), f.name

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable, Iterator
 
 import numpy as np
@@ -96,7 +96,7 @@ class PathSettings:
 class PathState:
     """What continues a path after a restart (stored in checkpoint.npz as ``path.*``)."""
 
-    mode: str = ""  # "load", "arc" or "dissipation"; "" before the first increment
+    mode: str = ""  # "load" (under arc-length control: a stretch), "arc", "dissipation"; "" at first
     size: float = 0.0  # Δλ, Δl or Δτ of the next increment
     arc_length: float = 0.0  # the arc length (kept while the dissipation constraint acts)
     du_prev: np.ndarray | None = None  # full-space increment of the last step (predictor sign)
@@ -108,6 +108,10 @@ class PathState:
     last_increment: float = 0.0  # |Δλ| of the last load-controlled increment (size_insensitive)
     last_iterations: int = 0  # and its Newton iterations
     lam_damaged: float = math.nan  # λ of the last increment in which damage grew (force paths; unloading())
+    # arc-length control: (size, Newton iterations) of the last ARC_WINDOW increments under the
+    # constraint ``recent_mode`` ("arc": Δl; "load", a stretch: Δλ) (size_insensitive)
+    recent: list = field(default_factory=list)
+    recent_mode: str = ""
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
@@ -119,6 +123,9 @@ class PathState:
                "path.lam_damaged": np.array(self.lam_damaged)}
         if self.du_prev is not None:
             out["path.du_prev"] = self.du_prev.copy()
+        if self.recent:
+            out["path.recent"] = np.array(self.recent, float).reshape(-1, 2)
+            out["path.recent_mode"] = np.array(self.recent_mode)
         return out
 
     @classmethod
@@ -131,7 +138,10 @@ class PathState:
                    float(a["path.arc_length0"]), bool(a["path.changed"]),
                    float(a["path.last_increment"]) if "path.last_increment" in a else 0.0,
                    int(a["path.last_iterations"]) if "path.last_iterations" in a else 0,
-                   float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan)
+                   float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan,
+                   [(float(x), int(n)) for x, n in np.asarray(a["path.recent"]).reshape(-1, 2)]
+                   if "path.recent" in a else [],
+                   str(a["path.recent_mode"]) if "path.recent_mode" in a else "")
 
 
 @dataclass
@@ -676,6 +686,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     displacement_path = arc and prescribed_direction(problem) is not None
     reaction: float | None = None  # R = gᵀ f_int at the committed state (displacement paths; conjugates)
     rescue: str | None = None  # a crawl's stop message while one load-controlled increment tries to pass it
+    # a stretch of load-controlled increments under arc-length control (st.mode "load"): where it
+    # began (its first accepted increment), how many it accepted, and the load factor below
+    # which no new one starts (where the last one ended without passing, see stretch_may_start)
+    stretch_from, stretch_accepted, stretch_block, stretch_end = lam, 0, -math.inf, False
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
@@ -764,18 +778,22 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # through closure meets the constraint without any damage (the force-loaded DCB
                 # on 150 elements 'converged' from λ = 0.42 to -0.03 with its arms shut)
                 ok, msg = False, "the dissipation constraint crossed λ = 0 (closure, not damage)"
-            if (ok and rescue is not None and not allow_jump and measure is not None and ps.jump_area is not None
+            if (ok and arc and st.mode == "load" and not allow_jump and measure is not None and ps.jump_area is not None
                     and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
-                # a rescue's Newton solve updates the cohesive sets itself: a snap-back it passes
-                # (half of the slab's interface debonding at once, no re-solution to see it in)
-                # shows only in the converged increment's debonded area
+                # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
+                # it passes (half of the slab's interface debonding at once, no re-solution to see
+                # it in) shows only in the converged increment's debonded area
                 ok, msg = False, "debonding jump"
             if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
                 if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
                                  scales, floors(att.u) if floors is not None else None):
                     ok, msg = False, "probe jump"
-            if ok and b0 is not None and st.mode != "load":  # under load (displacement) control a node row
-                # that releases within a step is a jump of the path, which shorter steps do not resolve
+            if ok and b0 is not None and (st.mode != "load" or rescue is None):
+                # (b0: arc-length control; its stretches of load-controlled increments too - the
+                # MMB's second rise to λ = 1, its crack still growing, took increments too long for
+                # the ledger: balance 1.8 % - but not a rescue, where a load-controlled increment
+                # is the last resort: a node row that releases within it is a jump of the path,
+                # which shorter increments do not resolve)
                 e_rel = energy_control(b0, balance_terms(problem, att.u), ps.energy_tolerance)
                 if e_rel > 1.0 and cuts < ps.max_energy_cuts:
                     ok, msg = False, "energy balance"
@@ -808,6 +826,18 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
             jump = msg in ("debonding jump", "probe jump")
             limit = cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts)
+            if arc and st.mode == "load" and rescue is None and (jump or cuts > STRETCH_CUTS or limit):
+                # a stretch of load-controlled increments ends where one does not converge within
+                # STRETCH_CUTS halvings, or jumps (a snap-back, or a peak): the arc length again
+                # from the last state, its direction by the work criterion
+                if stretch_accepted:
+                    warns.append(f"step {n}: load-controlled increments took the path from load factor "
+                                 f"{stretch_from:.6g} to {lam:.6g}; from there the arc length again (the next "
+                                 f"load-controlled increment: {msg})")
+                # (no new stretch until the arc length has passed the load the last failed increment aimed at)
+                stretch_block, stretch_accepted = lam + st.size, 0
+                st.mode, st.size, st.changed, cuts = "arc", st.arc_length, True, 0
+                continue
             if st.mode == "load" and s.unstable == "relax" and not jump and (cuts > ps.relax_after_cuts or limit):
                 # a step without equilibrium nearby fails at every size (the 100-element DCB spent
                 # ~100 iterations on each of up to 20 cuts of the step before a snap-back): relax
@@ -871,14 +901,23 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)
+        used = abs(dlam) if st.mode == "load" else st.size  # the size of this increment
         fac = min(2.0, max(0.5, ps.target_iterations / its))
         if cuts:
             fac = min(fac, 1.0)  # no growth right after a cut
-        elif (st.mode == "load" and abs(dlam) < INSENSITIVE_BELOW * ps.increment
-              and size_insensitive(abs(dlam), its, st.last_increment, st.last_iterations, ps.target_iterations)):
+        elif (not arc and st.mode == "load" and abs(dlam) < INSENSITIVE_BELOW * ps.increment
+              and size_insensitive(abs(dlam), its, [(st.last_increment, st.last_iterations)], ps.target_iterations)):
+            fac = max(fac, INSENSITIVE_GROWTH)
+        elif (arc and (st.mode == "load" or (st.mode == "arc" and st.size < INSENSITIVE_BELOW * st.arc_length0))
+              and size_insensitive(used, its, st.recent if st.recent_mode == st.mode else [], ps.target_iterations)):
+            # (a stretch of load-controlled increments at any size: the slab on 16 × 12 took 6-10
+            # iterations at Δλ = 0.4-5 kN/m², and the plain rule shrank them from 5 to 0.4)
             fac = max(fac, INSENSITIVE_GROWTH)
         if st.mode == "load":
             st.last_increment, st.last_iterations = abs(dlam), its
+        if arc and st.mode in ("arc", "load"):
+            st.recent = ((st.recent if st.recent_mode == st.mode else []) + [(used, its)])[-ARC_WINDOW:]
+            st.recent_mode = st.mode
         if e_rel > 0.5:
             fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
         if st.mode == "load":
@@ -898,18 +937,39 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # nothing left to dissipate (the interface has separated, the reaction vanished):
                 # the prescribed displacement goes on elastically, by the arc length
                 st.mode, st.size = "arc", st.arc_length
-        rescued = rescue is not None
-        if rescued:  # the load-controlled increment passed the crawl: the arc length again
+        if rescue is not None:  # the load-controlled increment passed the crawl: a stretch of them goes on
             warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
                          f"crawled or found no equilibrium); one load-controlled increment passed it to "
                          f"{att.lam:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
-                         "had no solution)")
-            st.mode, st.size, rescue = "arc", st.arc_length, None
+                         "had no solution); load-controlled increments go on while they converge without a jump")
+            rescue, stretch_from, stretch_accepted = None, lam, 1
+        elif arc and st.mode == "load":
+            if not stretch_accepted:
+                stretch_from = lam
+            stretch_accepted += 1
+            if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
+                # to it otherwise: the slab on 16 × 12 went 323.5, 324.9, 325.29, 325.44, 325.456,
+                # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
+                which = "one load-controlled increment" if stretch_accepted == 1 else "load-controlled increments"
+                warns.append(f"step {n}: {which} took the path from load factor {stretch_from:.6g} to {att.lam:.6g}, "
+                             f"on a rising branch where the arc length's increments needed cuts; from there the "
+                             f"arc length again (this increment needed {cuts} halving(s))")
+                stretch_block, stretch_accepted = att.lam + abs(att.lam - lam), 0
+                stretch_end = True
+            elif stretch_accepted == 1:
+                warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
+                             f"increments needed cuts, load-controlled increments go on while they converge "
+                             f"without a jump (to {att.lam:.6g} in this one)")
         st.du_prev = du
-        st.changed = resolves > 0 or rescued  # the next direction by the work criterion
+        st.changed = resolves > 0  # the next direction by the work criterion
+        if stretch_end:
+            st.mode, st.size, st.changed, stretch_end = "arc", st.arc_length, True, False
         u, lam = att.u, att.lam
         reaction = conj[1] if conj is not None else None
-        st.lam_peak = max(st.lam_peak, abs(lam))
+        peak_before, st.lam_peak = st.lam_peak, max(st.lam_peak, abs(lam))
+        if (st.mode in ("arc", "dissipation") and stretch_may_start(ps, arc, displacement_path, cuts, lam, dlam,
+                                                                     peak_before, stretch_block)):
+            st.mode, st.size, stretch_accepted = "load", _rescue_increment(ps, lam), 0
         if st.mode == "load":
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
         else:
@@ -948,9 +1008,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
                          start_inertia(problem))
-        res.state = PathState(st.mode, st.size, st.arc_length, None if st.du_prev is None else st.du_prev.copy(),
-                              st.lam_peak, st.dissipated, st.finished, st.arc_length0, st.changed,
-                              st.last_increment, st.last_iterations)
+        res.state = replace(st, du_prev=None if st.du_prev is None else st.du_prev.copy(),
+                            recent=list(st.recent))  # (a copy of every field: lam_damaged was
+        # left out of the field-by-field copy before, and a restart lost it)
         res.warnings = warns
         res.dissipation = dG
         res.end = end_reason  # why the path ends here ("lambda_end", "complete failure", "max_steps"), else None
@@ -980,6 +1040,29 @@ def _may_rescue(ps: PathSettings, arc: bool, lam: float) -> bool:
     return ps.load_rescue and arc and lam > 0.0
 
 
+#: a stretch of load-controlled increments under arc-length control ends at the first increment
+#: that does not converge within this many halvings (or jumps), or after one that needed them
+STRETCH_CUTS = 1
+
+
+def stretch_may_start(ps: PathSettings, arc: bool, displacement_path: bool, cuts: int, lam: float, dlam: float,
+                      peak_before: float, block: float) -> bool:
+    """After an accepted arc-length (or dissipation-controlled) increment: do load-controlled
+    increments take over? On a force path (not a prescribed displacement), where the increment
+    needed ``cuts`` and raised λ above its peak so far (a rising branch) and above ``block``,
+    where the last stretch ended. On such a branch the equilibria of load control are the arc
+    length's, and load control's Newton with its own active-set loop steps over the local
+    snap-backs of single interface points that the arc length traces one by one: the cohesive
+    slab on 16 × 12 (test_slab_trc_soffit.py) rose from 242.44 kN/m² by 5 kN/m² in one
+    load-controlled increment (11 iterations), where its arc-length increments advanced
+    0.04-0.5 kN/m² each, with 4-7 cuts in every few. The stretch ends where a load-controlled
+    increment fails within STRETCH_CUTS halvings or jumps, or after one that needed a halving
+    (near a peak or a snap-back): the arc length traces it from there. (On displacement paths
+    load control is the displacement control that the arc length's users chose not to run.)"""
+    return (_may_rescue(ps, arc, lam) and not displacement_path and cuts > 0 and dlam > 0.0
+            and lam >= peak_before and lam > block)
+
+
 def _rescue_increment(ps: PathSettings, lam: float) -> float:
     """The first Δλ of a load-controlled rescue: the run's first increment (its cuts halve it)."""
     return max(ps.increment, abs(lam) * ps.end_fraction)
@@ -1004,7 +1087,7 @@ def ledger_booked(problem: Problem) -> tuple[float, float]:
 #: accepted (closure)
 CONSTRAINT_BOOKED = 0.5
 
-#: load control: the growth of an increment whose iterations do not depend on its size
+#: load control and arc length: the growth of an increment whose iterations do not depend on its size
 #: (:func:`size_insensitive`)
 INSENSITIVE_GROWTH = 1.5
 #: ... only for increments cut below this share of the first (the crawl after a jump). Above it
@@ -1014,21 +1097,38 @@ INSENSITIVE_GROWTH = 1.5
 INSENSITIVE_BELOW = 1.0 / 16.0
 
 
-def size_insensitive(dlam: float, its: int, dlam_prev: float, its_prev: int, target: int) -> bool:
-    """Does the iteration count of a load-controlled increment not depend on its size? Against
-    the last increment (``dlam_prev``, ``its_prev`` iterations): at least 10 % longer and no more
-    than one iteration more, or at least 10 % shorter and no more than one iteration fewer; in
-    both cases within twice the target. The step-size rule Δλ × target/its assumes that a
-    shorter increment converges in fewer iterations. Where a state that each commit changes sets
-    the count (the thesis's slip-softening friction relaxing after the Gmsh plate's debonding
-    jump at λ = 0.496: increments of 10⁻⁵ to 3·10⁻⁴ all took 6-12 iterations, the first residual
-    set by the committed friction, not by Δλ), the rule held Δλ near 10⁻⁵ for 1000 increments.
-    Such increments, where cut below INSENSITIVE_BELOW of the first, grow by INSENSITIVE_GROWTH
-    until the count rises with the size, exceeds twice the target, or an increment fails."""
-    if dlam_prev <= 0.0 or its > 2 * target:
+def size_insensitive(size: float, its: int, recent: list[tuple[float, int]], target: int) -> bool:
+    """Does the iteration count of an increment not depend on its size? Against the last
+    increments ``recent`` ((size, iterations) pairs: the last one under load control, the last
+    ARC_WINDOW under the same constraint under arc-length control): at least 10 % longer than
+    the shortest of them and no more than one iteration more than the most, or at least 10 %
+    shorter than the longest and no more than one iteration fewer than the fewest; in both
+    cases within twice the target. The
+    step-size rule (size × target/its) assumes that a shorter increment converges in fewer
+    iterations. Where a state that each commit changes sets the count, it does not:
+    - load control: the thesis's slip-softening friction relaxing after the Gmsh plate's
+      debonding jump at λ = 0.496 (increments of 10⁻⁵ to 3·10⁻⁴ all took 6-12 iterations, the
+      first residual set by the committed friction, not by Δλ) held Δλ near 10⁻⁵ for 1000
+      increments;
+    - arc length: the cohesive slab on 16 × 12 (test_slab_trc_soffit.py) from 225 kN/m²,
+      arc lengths of 8·10⁻⁶, 8·10⁻⁵ and 8·10⁻⁴ took 5, 7-9 and 9 iterations (the first
+      iteration halves the residual, whatever its size, and every other increment's sets change
+      once at its solution): 8·10⁻⁵, 1 % of the first, with 0.04 kN/m² per increment. Its
+      counts alternate (7, 9, 7, ...), hence the window of two.
+    Such increments, where cut below INSENSITIVE_BELOW of the first (in a stretch of
+    load-controlled increments under arc-length control: at any size), grow by
+    INSENSITIVE_GROWTH until the count rises with the size, exceeds twice the target, or an
+    increment fails."""
+    recent = [(x, n) for x, n in recent if x > 0.0]
+    if not recent or its > 2 * target:
         return False
-    return ((dlam >= 1.1 * dlam_prev and its <= its_prev + 1)
-            or (dlam * 1.1 <= dlam_prev and its >= its_prev - 1))
+    sizes, counts = [x for x, _ in recent], [n for _, n in recent]
+    return ((size >= 1.1 * min(sizes) and its <= max(counts) + 1)
+            or (size * 1.1 <= max(sizes) and its >= min(counts) - 1))
+
+
+#: arc-length control: the increments :func:`size_insensitive` compares with
+ARC_WINDOW = 2
 
 
 #: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
