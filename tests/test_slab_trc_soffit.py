@@ -220,3 +220,36 @@ def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
         assert "a load-controlled increment from it" in r.message or "unloads without damage" in r.message
     else:  # passed the snap-back: traced (the balance holds) or warned
         assert max(balance) < 0.01 or any("the debonded area jumped" in w for w in s["warnings"])
+
+
+def test_a_restart_inside_a_stretch_of_load_controlled_increments_goes_on_as_before(tmp_path):
+    """The cohesive slab by arc length (8 × 6) hands its rising branch to load-controlled
+    increments from step 6 (solver/arclength.py, stretch_may_start). A run interrupted at step 8,
+    inside that stretch, and restarted from its checkpoint gives the uninterrupted run's states
+    at steps 9 and 10 (the path state, with its mode and the window of the step-size rule, is
+    in the checkpoint)."""
+    import json
+
+    spec = example_spec("slab_trc_soffit", {**COHESIVE, "lambda_end = 100.0": "lambda_end = 400.0",
+                                            "n = 20\n": 'n = 80\ncontrol = "arc_length"\nmax_steps = 3000\n'})
+
+    def stop_at(k):
+        def progress(n, total, lam):
+            if n >= k:
+                raise KeyboardInterrupt
+        return progress
+
+    run(spec, tmp_path / "a", write_vtu=False, progress=stop_at(10))
+    run(spec, tmp_path / "b", write_vtu=False, progress=stop_at(8))
+    run(spec, tmp_path / "b", write_vtu=False, progress=stop_at(10), restart=tmp_path / "b")
+    a, b = ([json.loads(line) for line in open(tmp_path / d / "steps.jsonl")] for d in ("a", "b"))
+    assert [st["step"] for st in b] == list(range(1, 11))
+    modes = [st["path"]["constraint"] for st in a]
+    assert modes[7:10] == ["load"] * 3  # steps 9 and 10 are load-controlled (a step's record: the next one's)
+    warnings = json.load(open(tmp_path / "a" / "summary.json"))["warnings"]
+    assert any("load-controlled increments go on" in w for w in warnings)
+    for sa, sb in zip(a[8:], b[8:]):
+        assert sb["load_factor"] == pytest.approx(sa["load_factor"], rel=1e-10)
+        assert sb["probes"]["w_mid"] == pytest.approx(sa["probes"]["w_mid"], rel=1e-9)
+        assert sb["path"]["constraint"] == sa["path"]["constraint"]
+        assert sb["path"]["size"] == pytest.approx(sa["path"]["size"], rel=1e-9)
