@@ -709,6 +709,17 @@ def test_load_column_of_prescribed_displacements_is_the_tangent_times_g(nonlinea
     assert np.allclose(load_rate(pb, u), pb.F_scaled - stiffness_along(pb, u, g), rtol=0, atol=1e-12 * np.abs(Kg).max())
 
 
+
+def _path_stand_ins(monkeypatch, al, **patches) -> None:
+    """Stand-ins for the problem-side helpers of arclength.path_steps (no interfaces, no
+    prescribed displacements, nothing dissipated), plus ``patches`` (name: stand-in)."""
+    common = {"check_path": lambda p, ps: None, "interface_form": lambda p: False,
+              "prescribed_direction": lambda p: None, "dissipation_so_far": lambda p: 0.0,
+              "dissipation_increment": lambda *a: 0.0, "conjugates": lambda p, u: (0.0, 0.0),
+              "check_stabilised_step": lambda *a: None}
+    for name, value in {**common, **patches}.items():
+        monkeypatch.setattr(al, name, value)
+
 def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypatch):
     """Where the arc length's increments fail at their smallest size (or crawl), one
     load-controlled increment is tried from the last state (Newton with its own active-set loop);
@@ -729,11 +740,7 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
         ok = lam <= 0.5 + 1e-12
         return u + 1.0, NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
 
-    for name, value in (("arc_attempt", never), ("newton", newton_to_half), ("check_path", lambda p, ps: None),
-                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
-                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
-                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None)):
-        monkeypatch.setattr(al, name, value)
+    _path_stand_ins(monkeypatch, al, arc_attempt=never, newton=newton_to_half)
     pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
                          begin_step=lambda: None)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
@@ -815,12 +822,7 @@ def test_a_rising_branch_on_which_the_arc_length_needs_cuts_is_taken_by_load_con
         ok = lam <= 0.6 + 1e-12
         return u + 1.0, NewtonResult(ok, 8, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
 
-    for name, value in (("arc_attempt", arc_to_half), ("newton", newton_to_06), ("check_path", lambda p, ps: None),
-                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
-                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
-                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None),
-                        ("full_weights", lambda p: 1.0)):
-        monkeypatch.setattr(al, name, value)
+    _path_stand_ins(monkeypatch, al, arc_attempt=arc_to_half, newton=newton_to_06, full_weights=lambda p: 1.0)
     pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
                          begin_step=lambda: None)
     ps = al.PathSettings(control="arc_length", lambda_end=10.0, increment=0.25, arc_length=1.0, max_cuts=4,
@@ -872,13 +874,8 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
         return al.Attempt(True, u + 1e-3, lam - 0.01 if mode == "dissipation" else lam + 0.01, 3, [1e-10])
 
     booked = {"damage": 0.0}
-    for name, value in (("arc_attempt", attempt), ("check_path", lambda p, ps: None),
-                        ("interface_form", lambda p: False), ("prescribed_direction", lambda p: None),
-                        ("dissipation_so_far", lambda p: 0.0), ("dissipation_increment", lambda *a: 0.0),
-                        ("conjugates", lambda p, u: (0.0, 0.0)), ("check_stabilised_step", lambda *a: None),
-                        ("ledger_booked", lambda p: (booked["damage"], booked["damage"])),
-                        ("arc_weights", lambda p: 1.0)):
-        monkeypatch.setattr(al, name, value)
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]))
     itf = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
 
     def on_step_end(problem, u, lam):  # commits the state: damage booked where asked
@@ -910,8 +907,8 @@ def test_the_path_state_survives_a_checkpoint_whole():
     from layershell.solver import arclength as al
 
     st = al.PathState(mode="arc", size=2e-4, arc_length=3e-4, du_prev=np.arange(3.0), lam_peak=2.5,
-                      dissipated=0.7, finished=True, arc_length0=1e-2, changed=True, last_increment=0.01,
-                      last_iterations=6, lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc")
+                      dissipated=0.7, finished=True, arc_length0=1e-2, changed=True,
+                      lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc")
     assert all(getattr(st, f.name) != getattr(al.PathState(), f.name) for f in fields(st)
                if f.name != "du_prev")
     back = al.PathState.from_arrays(st.arrays())
@@ -920,3 +917,8 @@ def test_the_path_state_survives_a_checkpoint_whole():
             np.testing.assert_array_equal(back.du_prev, st.du_prev)
         else:
             assert getattr(back, f.name) == getattr(st, f.name), f.name
+    # a checkpoint written before `recent` kept the last load-controlled increment on its own
+    old = {k: v for k, v in st.arrays().items() if k not in ("path.recent", "path.recent_mode")}
+    old.update({"path.last_increment": np.array(0.01), "path.last_iterations": np.array(6)})
+    back = al.PathState.from_arrays(old)
+    assert back.recent == [(0.01, 6)] and back.recent_mode == "load"

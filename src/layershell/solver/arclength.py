@@ -105,11 +105,10 @@ class PathState:
     finished: bool = False
     arc_length0: float = 0.0  # the first arc length (sets the default bounds)
     changed: bool = False  # the last increment changed the state (debonding): work criterion next
-    last_increment: float = 0.0  # |Δλ| of the last load-controlled increment (size_insensitive)
-    last_iterations: int = 0  # and its Newton iterations
     lam_damaged: float = math.nan  # λ of the last increment in which damage grew (force paths; unloading())
-    # arc-length control: (size, Newton iterations) of the last ARC_WINDOW increments under the
-    # constraint ``recent_mode`` ("arc": Δl; "load", a stretch: Δλ) (size_insensitive)
+    # (size, Newton iterations) of the last increments under the constraint ``recent_mode``
+    # ("load": Δλ, "arc": Δl): the last one under load control, ARC_WINDOW under arc-length
+    # control (size_insensitive)
     recent: list = field(default_factory=list)
     recent_mode: str = ""
 
@@ -118,8 +117,6 @@ class PathState:
                "path.arc_length": np.array(self.arc_length), "path.lam_peak": np.array(self.lam_peak),
                "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
                "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed),
-               "path.last_increment": np.array(self.last_increment),
-               "path.last_iterations": np.array(self.last_iterations),
                "path.lam_damaged": np.array(self.lam_damaged)}
         if self.du_prev is not None:
             out["path.du_prev"] = self.du_prev.copy()
@@ -136,12 +133,19 @@ class PathState:
                    np.array(a["path.du_prev"], float) if "path.du_prev" in a else None,
                    float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
                    float(a["path.arc_length0"]), bool(a["path.changed"]),
-                   float(a["path.last_increment"]) if "path.last_increment" in a else 0.0,
-                   int(a["path.last_iterations"]) if "path.last_iterations" in a else 0,
                    float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan,
-                   [(float(x), int(n)) for x, n in np.asarray(a["path.recent"]).reshape(-1, 2)]
-                   if "path.recent" in a else [],
-                   str(a["path.recent_mode"]) if "path.recent_mode" in a else "")
+                   *_recent_from_arrays(a))
+
+
+def _recent_from_arrays(a: dict[str, np.ndarray]) -> tuple[list, str]:
+    """PathState.recent and recent_mode from a checkpoint's arrays; checkpoints written before
+    them kept the last load-controlled increment as path.last_increment / last_iterations."""
+    if "path.recent" in a:
+        return ([(float(x), int(n)) for x, n in np.asarray(a["path.recent"]).reshape(-1, 2)],
+                str(a["path.recent_mode"]))
+    if float(a.get("path.last_increment", 0.0)) > 0.0:
+        return [(float(a["path.last_increment"]), int(a["path.last_iterations"]))], "load"
+    return [], ""
 
 
 @dataclass
@@ -689,7 +693,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     # a stretch of load-controlled increments under arc-length control (st.mode "load"): where it
     # began (its first accepted increment), how many it accepted, and the load factor below
     # which no new one starts (where the last one ended without passing, see stretch_may_start)
-    stretch_from, stretch_accepted, stretch_block, stretch_end = lam, 0, -math.inf, False
+    stretch_from, stretch_accepted, stretch_block = lam, 0, -math.inf
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
@@ -902,21 +906,20 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         its = max(att.iterations, 1)
         used = abs(dlam) if st.mode == "load" else st.size  # the size of this increment
+        history = st.recent if st.recent_mode == st.mode else []  # the last ones under this constraint
         fac = min(2.0, max(0.5, ps.target_iterations / its))
         if cuts:
             fac = min(fac, 1.0)  # no growth right after a cut
-        elif (not arc and st.mode == "load" and abs(dlam) < INSENSITIVE_BELOW * ps.increment
-              and size_insensitive(abs(dlam), its, [(st.last_increment, st.last_iterations)], ps.target_iterations)):
+        elif (st.mode in ("load", "arc")
+              # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
+              # increments at any size (the slab on 16 × 12 took 6-10 iterations at Δλ = 0.4-5
+              # kN/m², and the plain rule shrank them from 5 to 0.4)
+              and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
+                   or (arc and st.mode == "load"))
+              and size_insensitive(used, its, history, ps.target_iterations)):
             fac = max(fac, INSENSITIVE_GROWTH)
-        elif (arc and (st.mode == "load" or (st.mode == "arc" and st.size < INSENSITIVE_BELOW * st.arc_length0))
-              and size_insensitive(used, its, st.recent if st.recent_mode == st.mode else [], ps.target_iterations)):
-            # (a stretch of load-controlled increments at any size: the slab on 16 × 12 took 6-10
-            # iterations at Δλ = 0.4-5 kN/m², and the plain rule shrank them from 5 to 0.4)
-            fac = max(fac, INSENSITIVE_GROWTH)
-        if st.mode == "load":
-            st.last_increment, st.last_iterations = abs(dlam), its
-        if arc and st.mode in ("arc", "load"):
-            st.recent = ((st.recent if st.recent_mode == st.mode else []) + [(used, its)])[-ARC_WINDOW:]
+        if st.mode in ("load", "arc"):
+            st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
             st.recent_mode = st.mode
         if e_rel > 0.5:
             fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
@@ -937,6 +940,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # nothing left to dissipate (the interface has separated, the reaction vanished):
                 # the prescribed displacement goes on elastically, by the arc length
                 st.mode, st.size = "arc", st.arc_length
+        st.du_prev = du
+        st.changed = resolves > 0  # the next direction by the work criterion
         if rescue is not None:  # the load-controlled increment passed the crawl: a stretch of them goes on
             warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
                          f"crawled or found no equilibrium); one load-controlled increment passed it to "
@@ -955,15 +960,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                              f"on a rising branch where the arc length's increments needed cuts; from there the "
                              f"arc length again (this increment needed {cuts} halving(s))")
                 stretch_block, stretch_accepted = att.lam + abs(att.lam - lam), 0
-                stretch_end = True
+                st.mode, st.size, st.changed = "arc", st.arc_length, True
             elif stretch_accepted == 1:
                 warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
                              f"increments needed cuts, load-controlled increments go on while they converge "
                              f"without a jump (to {att.lam:.6g} in this one)")
-        st.du_prev = du
-        st.changed = resolves > 0  # the next direction by the work criterion
-        if stretch_end:
-            st.mode, st.size, st.changed, stretch_end = "arc", st.arc_length, True, False
         u, lam = att.u, att.lam
         reaction = conj[1] if conj is not None else None
         peak_before, st.lam_peak = st.lam_peak, max(st.lam_peak, abs(lam))
