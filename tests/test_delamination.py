@@ -296,17 +296,30 @@ def test_contact_iteration_cap_from_the_model_file(monkeypatch):
     bisect the first increment of the §5.1 plate (14 iterations otherwise, no bisection). The
     re-equilibration after the first debonding cannot be bisected: it gets
     REEQUILIBRATION_BUDGET (4) times the cap and converges. With the budget of a load step and
-    the Gauss points asked for (rule = "gauss") it stops with a message that names the setting,
-    and the converged step is kept; with the rule left open the contact moves to the nodes there
-    (contact_to_nodes), the run reaches its end, and summary.json and a warning say where."""
-    from layershell.runner import ContactRuleWarning
+    the Gauss points asked for (rule = "gauss") the re-solution fails; pseudo-transient settling
+    (newton.settle) then finds the equilibrium that the full budget finds (w_front_max to 10⁻⁹;
+    measured 6·10⁻¹³), and summary.json 'settlements' and a warning say so. Without settling the
+    run stops with a message that names the setting, and the converged step is kept; with the
+    rule left open the contact moves to the nodes there (contact_to_nodes), the run reaches its
+    end, and summary.json and a warning say where."""
+    from layershell.runner import ContactRuleWarning, JumpWarning
     from layershell.solver import newton
 
     case = {"n = 24": "factors = [0.5, 0.6]\nmax_contact_iterations = 8"}
     budget = run_example("cantilever_plate_slip", case)
     assert budget.converged and budget.summary["steps"][0]["bisections"] >= 1
     assert "contact_moved_to_nodes" not in budget.summary
+    full = run_example("cantilever_plate_slip", {**case, **GAUSS_CONTACT})
+    assert full.converged and "settlements" not in full.summary
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
+    with pytest.warns(JumpWarning, match="at load factor 0.6 after new releases found no equilibrium by Newton"):
+        settled = run_example("cantilever_plate_slip", {**case, **GAUSS_CONTACT})
+    assert settled.converged and settled.summary["steps"][-1]["load_factor"] == 0.6
+    (ev,) = settled.summary["settlements"]
+    assert (ev["step"], ev["load_factor"], ev["pushes"]) == (2, 0.6, 0)
+    assert "max_contact_iterations" in ev["reason"] and ev["energy_released"] > 0
+    assert settled.summary["probes"]["w_front_max"] == pytest.approx(full.summary["probes"]["w_front_max"], rel=1e-9)
+    monkeypatch.setattr(newton, "settle", _no_settling)
     capped = run_example("cantilever_plate_slip", {**case, **GAUSS_CONTACT})
     assert not capped.converged and "max_contact_iterations" in capped.message
     assert 'rule = "lobatto"' in capped.message
@@ -320,6 +333,13 @@ def test_contact_iteration_cap_from_the_model_file(monkeypatch):
     assert any("acts at the nodes" in w for w in moved.summary["warnings"])
     plain = run_example("cantilever_plate_slip", {"n = 24": "factors = [0.5, 0.6]"})
     assert plain.converged and all(st["bisections"] == 0 for st in plain.summary["steps"])
+
+
+def _no_settling(problem, u, lam, s, why=""):
+    """A stand-in for newton.settle that gives up at once (the behaviour without it)."""
+    from layershell.solver.newton import NewtonResult
+
+    return u, NewtonResult(False, 0, message="settling switched off")
 
 
 @pytest.mark.parametrize("name", ["cantilever_plate_bonded", "cantilever_plate_slip"])
@@ -544,16 +564,26 @@ def test_contact_set_violation_is_the_traction_error_in_units_of_the_strength():
     assert blk.set_violation(u) == np.inf
 
 
-def test_a_cycling_contact_set_is_not_accepted_with_interpenetration():
+def test_a_cycling_contact_set_is_not_accepted_with_interpenetration(monkeypatch):
     """examples/plate_gmsh.toml, whose Gauss-point contact set cycles at λ = 0.5 (re-solution):
     before, a contact set still changing after the allowed active-set loops was accepted as it
     was, and the run reported states with released points interpenetrating by up to 0.24 mm (λ
     = 0.875) or pulled open in the set (λ = 0.5: a tension of 1.3 σ_max under α_N). Now such a
-    state is accepted only within CONTACT_SET_TOL of the strength: with rule = "gauss" the run
-    stops at λ = 0.5 naming the violation; with the rule left open the contact moves to the
-    nodes there and the run reaches λ = 1, every contact set holding where it converged."""
+    state is accepted only within CONTACT_SET_TOL of the strength: with rule = "gauss" and
+    without pseudo-transient settling the run stops at λ = 0.5 naming the violation; with the
+    rule left open the contact moves to the nodes there and the run reaches λ = 1, every contact
+    set holding where it converged. With rule = "gauss" and settling (newton.settle, the
+    default) the re-solution settles to an equilibrium whose contact set holds, and the run
+    reaches λ = 1 on the Gauss points' rule (w_front_max 0.06095 m, the nodal rule 0.06154)."""
+    from layershell.solver import newton
     from layershell.solver.newton import CONTACT_SET_TOL
 
+    settled = run_example("plate_gmsh", GAUSS_CONTACT)
+    assert settled.converged and settled.summary["steps"][-1]["load_factor"] == 1.0
+    assert "contact_moved_to_nodes" not in settled.summary and "active_set" not in settled.summary
+    assert len(settled.summary["settlements"]) >= 1
+    assert all("violates the contact condition" in ev["reason"] for ev in settled.summary["settlements"])
+    monkeypatch.setattr(newton, "settle", _no_settling)
     gauss = run_example("plate_gmsh", GAUSS_CONTACT)
     assert not gauss.converged and gauss.summary["steps"][-1]["load_factor"] < 1.0
     m = re.search(r"violates the contact condition by a traction of ([0-9.e+-]+) × the interface strength",
@@ -565,6 +595,8 @@ def test_a_cycling_contact_set_is_not_accepted_with_interpenetration():
     # 0.5 with numpy 1.26-2.3, 0.875 with numpy 2.4 / MKL 2026.2; either stops the Gauss run)
     assert [mv["load_factor"] for mv in moved.summary["contact_moved_to_nodes"]] == [gauss.failure["load_factor"]]
     assert "active_set" not in moved.summary  # every contact set held exactly where it converged
+    w = [r.summary["probes"]["w_front_max"] for r in (settled, moved)]
+    assert w[0] == pytest.approx(w[1], rel=0.02)
 
 
 NODAL_CONTACT = {"[[interfaces]]": '[[interfaces]]\nrule = "lobatto"'}
@@ -575,7 +607,8 @@ REFINED = {"nx = 3": "nx = 12", "ny = 3": "ny = 12"}
 @pytest.mark.slow
 def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     """The §5.1 plate with slip-softening friction refined to 12 × 12 (issue 13, robustness), with
-    the budget of a load step for its re-solutions (REEQUILIBRATION_BUDGET = 1, as before it):
+    the budget of a load step for its re-solutions (REEQUILIBRATION_BUDGET = 1, as before it)
+    and without pseudo-transient settling (newton.settle, which would take that re-solution on):
     with the contact at the face Gauss points the contact set of the re-solution after the first
     cascade cycles (a stiff penalty at Gauss points: its tractions oscillate from point to point,
     Schellekens & de Borst 1993) and the run stops at λ = 0.375 with a message that names the
@@ -592,6 +625,7 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     (move,) = moved.summary["contact_moved_to_nodes"]
     assert 0.125 < move["load_factor"] < 1.0 and "cycles" in move["reason"]
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
+    monkeypatch.setattr(newton, "settle", _no_settling)
     gauss = run_example("cantilever_plate_slip", {**REFINED, **GAUSS_CONTACT})
     assert not gauss.converged and 'rule = "lobatto"' in gauss.message
     assert gauss.summary["steps"][-1]["load_factor"] == pytest.approx(0.375 - 1 / 24)
@@ -608,7 +642,8 @@ def test_refined_thesis_plate_with_strong_friction_needs_the_budget_of_its_re_so
     """The §5.1 plate with strong friction on 12 × 12, contact at the nodes: after the first
     cascade at λ = 0.5 the step's re-solutions take 314-338 iterations, the longest frozen solve
     30 (numpy 1.26-2.3) or 24 (numpy 2.4.6 / MKL 2026.2) of them. With the budget of a load step
-    the run stops there; with the re-solutions' budget (REEQUILIBRATION_BUDGET = 4: a
+    (and without pseudo-transient settling, newton.settle) the run stops there; with the
+    re-solutions' budget (REEQUILIBRATION_BUDGET = 4: a
     re-solution at the same load cannot be bisected) it reaches λ = 1. The test runs with
     ``max_iterations = 12``, so that both budgets are a factor of 2 away from the longest solve
     (12 and 48 against 24-30): with the default 25 round-off decided whether that solve fit
@@ -619,6 +654,7 @@ def test_refined_thesis_plate_with_strong_friction_needs_the_budget_of_its_re_so
     full = run_example("cantilever_plate_strong", case)
     assert full.converged and full.summary["steps"][-1]["load_factor"] == 1.0
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
+    monkeypatch.setattr(newton, "settle", _no_settling)
     step = run_example("cantilever_plate_strong", case)
     assert not step.converged and step.summary["steps"][-1]["load_factor"] == pytest.approx(0.5 - 1 / 24)
 

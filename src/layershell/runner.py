@@ -245,6 +245,25 @@ def _contact_moved(summary: dict, moves: list[dict], step: int, log) -> None:
     moves.clear()
 
 
+def _settled(summary: dict, events: list[dict], step: int, log) -> None:
+    """summary['settlements'] gets the re-solutions at a fixed load that only pseudo-transient
+    settling solved in this step (solver/newton.py settle), each a warning; ``events`` is
+    emptied."""
+    for ev in events:
+        summary.setdefault("settlements", []).append({"step": step, **ev})
+        fraction = ev.get("debonded_fraction")
+        m = (f"step {step}: the re-solution at load factor {ev['load_factor']:.6g} after new releases found no "
+             f"equilibrium by Newton's method from the last state ({ev['reason']}); with every DOF damped it "
+             f"settled to one in {ev['increments']} pseudo-time increments ({ev['iterations']} iterations), the "
+             f"displacements moving by up to {ev['largest_displacement_change']:.4g}"
+             + (f", debonded fraction {fraction:.4g}" if fraction is not None else "")
+             + f". That state is an equilibrium without the damping. Between the two states the structure snaps at "
+             f"a fixed load (a dynamic jump whose path is not followed), releasing {ev['energy_released']:.4g} (the "
+             "work of the out-of-balance forces along the damped path). summary.json 'settlements'")
+        _warn(summary, m, JumpWarning, log)
+    events.clear()
+
+
 def _ended_early(summary: dict, st, steps, log) -> None:
     """A path (arc length or adaptive steps) that ended at [steps] max_steps before lambda_end:
     its run is converged - every increment is an equilibrium - but it did not reach the load it
@@ -715,6 +734,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     _relaxed(summary, ctl.relaxations, energy, st.step, log)
                 if ctl is not None and getattr(ctl, "contact_moves", None):  # thesis contact moved to the nodes (solver/newton.py)
                     _contact_moved(summary, ctl.contact_moves, st.step, log)
+                if ctl is not None and getattr(ctl, "settlements", None):  # re-solutions settled (solver/newton.py settle)
+                    _settled(summary, ctl.settlements, st.step, log)
                 if getattr(problem, "accepted_sets", 0):  # cohesive active sets accepted within their tolerance (solver/newton.py)
                     summary["active_set"] = {"accepted_within_tolerance": problem.accepted_sets,
                                              "largest_violation": problem.accepted_violation}

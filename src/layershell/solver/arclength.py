@@ -744,7 +744,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         ok, msg = False, f"the state still changes after {max_resolves} re-solutions"
                         break
                     if st.mode == "load" or to_end:
-                        u_new, res = resolve(problem, att.u, att.lam, s)  # as load_steps (contact_to_nodes)
+                        # as load_steps (contact_to_nodes); a failure cuts the increment instead of settling
+                        u_new, res = resolve(problem, att.u, att.lam, s, may_settle=False)
                         att = Attempt(res.converged, u_new, att.lam, res.iterations, res.residuals, res.message)
                     else:  # the same increment again under the same constraint in the new state
                         att = arc_attempt(problem, u, lam, st.size, st.mode, None, s, ps,

@@ -177,6 +177,9 @@ class InterfaceController:
     # equilibrium (contact_to_nodes): one dict per move {load_factor, interfaces}
     contact_moves: list = field(default_factory=list)
     contact_moved_at: float | None = None  # the load factor of the last move (error messages)
+    # re-solutions at a fixed load that only pseudo-transient settling solved (solver/newton.py
+    # settle): one dict per event, reported and emptied by the runner
+    settlements: list = field(default_factory=list)
     energy: np.ndarray = field(default_factory=lambda: np.zeros(2))  # [external work, bulk strain energy]
     u_last: np.ndarray | None = None  # state of the last energy update (path integrals)
     f_last: np.ndarray | None = None  # [external force, layers' internal force] there

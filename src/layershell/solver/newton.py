@@ -489,6 +489,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     u = problem.impose(u, lam)
     Fext = problem.external(lam)
     ref = np.linalg.norm(op.reduce(Fext))
+    pv = getattr(problem, "pseudo", None)  # pseudo-transient damping (None: the static problem)
     pres = op.prescribed  # displacement control: the reactions there set the force scale
     res = NewtonResult(False, 0)
     e0 = en = None
@@ -501,7 +502,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     f, _ = asm.evaluate(u, tangent=False)
     best: tuple[float, np.ndarray | None] = (np.inf, None)
     for it in range(s.max_iterations + 1):
-        r = op.reduce(Fext - f)
+        r = op.reduce(Fext - f) if pv is None else op.reduce(Fext - f) - pv.force(op, u)
         rn = float(np.linalg.norm(r))
         res.residuals.append(rn)
         if not np.isfinite(rn):
@@ -541,6 +542,8 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             return u, res
         # K_r = Tᵀ K T (3.69)-(3.72) through the reduced scatter map cached per bond state
         _, Kr = asm.evaluate_reduced(u, op, forces=False)
+        if pv is not None:
+            Kr = pv.tangent(Kr)
         try:
             du = problem.solve_tangent(Kr, r, s.backend, s.reuse_factorization)
         except linear.SingularSystemError as exc:
@@ -555,7 +558,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
             record_scale(problem, scale)
             return u + dU, res
         f, _ = asm.evaluate(u + dU, tangent=False)
-        if globalise and float(np.linalg.norm(op.reduce(Fext - f))) > rn:
+        if globalise and _residual_norm(problem, Fext, f, u + dU) > rn:
             eta, f_eta = _line_search(problem, u, dU, Fext, rn, s)
             if eta != 1.0:
                 dU, f = eta * dU, f_eta
@@ -597,17 +600,25 @@ def record_scale(problem: Problem, scale: float) -> None:
         problem.force_scale = max(problem.force_scale, scale)
 
 
+def _residual_norm(problem: Problem, Fext: np.ndarray, f: np.ndarray, u: np.ndarray) -> float:
+    """‖Tᵀ(F_ext − f)‖, less the pseudo-transient damping force where it acts."""
+    r = problem.op.reduce(Fext - f)
+    pv = getattr(problem, "pseudo", None)
+    if pv is not None:
+        r = r - pv.force(problem.op, u)
+    return float(np.linalg.norm(r))
+
+
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
                  s: NewtonSettings) -> tuple[float, np.ndarray | None]:
     """Backtracking on the residual norm after the full Newton step increased it: halve the step
     (at most ``max_line_search`` times) until the residual decreases; returns that step length
     and the internal force there. If no step length helps, ``(1, None)`` (the full step is kept;
     Newton may still recover)."""
-    op = problem.op
     eta = 0.5
     for _ in range(s.max_line_search - 1):
         f, _ = problem.assembler.evaluate(u + eta * dU, tangent=False)
-        r = float(np.linalg.norm(op.reduce(Fext - f)))
+        r = _residual_norm(problem, Fext, f, u + eta * dU)
         if r <= rn:
             return eta, f
         eta *= 0.5
@@ -921,18 +932,225 @@ def contact_may_move(problem: Problem) -> bool:
 
 
 def resolve(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
-            may_move: bool = True) -> tuple[np.ndarray, NewtonResult]:
+            may_move: bool = True, may_settle: bool | None = None) -> tuple[np.ndarray, NewtonResult]:
     """The re-solution at ``lam`` after new releases, from the just committed ``u``; where it
     fails with the thesis's Gauss-point contact (and ``may_move``), once more with the contact at
-    the nodes (:func:`contact_to_nodes`). The result counts the iterations of both solves."""
+    the nodes (:func:`contact_to_nodes`); where that fails too (or nothing moved), and
+    ``may_settle`` (default: ``may_move``), by pseudo-transient settling (:func:`settle`) - the
+    last resort before the run stops, since a re-solution at the same load cannot be cut into
+    load increments (a caller that can cut the increment instead passes False). The result counts
+    the iterations of all solves."""
     u_r, r = newton(problem, u, lam, s)
     if not r.converged and may_move and contact_to_nodes(problem, u, lam, f"its re-solution after new releases: "
                                                                            f"{r.message}"):
         u_r, r2 = newton(problem, u, lam, s)
-        r2.iterations += r.iterations
-        r2.residuals = r.residuals + r2.residuals
-        r = r2
+        r = _joined(r, r2)
+    if not r.converged and (may_move if may_settle is None else may_settle):
+        u_s, r3 = settle(problem, u, lam, s, why=r.message)
+        r3 = _joined(r, r3)
+        if r3.converged:
+            return u_s, r3
+        r3.message = f"{r.message}; then {r3.message}"
+        r = r3
     return u_r, r
+
+
+def _joined(first: NewtonResult, then: NewtonResult) -> NewtonResult:
+    """``then`` with the iterations and residuals of ``first`` before its own."""
+    then.iterations += first.iterations
+    then.residuals = first.residuals + then.residuals
+    return then
+
+
+# settle(): the first pseudo-time step (in units of the damping D = |diag K_r|: with Δt = 1 the
+# damping is as stiff as the tangent's diagonal), its bounds, the increments and the Newton
+# iterations per increment it may take, and the damping force (a share of the load) below which
+# a static solve is tried
+SETTLE_DT0 = 1.0
+SETTLE_DT_MIN = 1e-6
+SETTLE_DT_MAX = 1e12
+SETTLE_MAX_INCREMENTS = 200
+SETTLE_ITERATIONS = 25
+SETTLE_STATIC = 1e-2
+# ... where it stops on an unstable equilibrium (a saddle of the potential, where the damping
+# force vanishes: started on one, or a static solve converged onto one), it is pushed along the
+# tangent's most negative mode by this share of the model's size and settles again, at most
+# SETTLE_PUSHES times (the imperfect column started on its unstable near-straight state at
+# 1.1 P_E: one push, then the elastica; tests/test_settle.py)
+SETTLE_PUSH = 1e-3
+SETTLE_PUSHES = 3
+
+
+@dataclass
+class PseudoViscosity:
+    """The damping term of pseudo-transient continuation: a reduced force (D/Δt)(u_r − u_r,n)
+    on every independent DOF, with D = |diag K_r| of the state the settling started from and
+    ``u_n`` the state at the start of the pseudo-time increment (``Problem.pseudo`` while set)."""
+
+    diag: np.ndarray  # D, per reduced DOF
+    u_n: np.ndarray  # full state at the start of the increment
+    rate: float  # 1/Δt
+
+    def force(self, op, u: np.ndarray) -> np.ndarray:
+        ind = op.independent
+        return self.rate * self.diag * (u[ind] - self.u_n[ind])
+
+    def tangent(self, Kr):
+        import scipy.sparse as sp
+
+        return Kr + sp.diags(self.rate * self.diag, format="csr")
+
+
+def push_off_saddle(problem: Problem, u: np.ndarray, lam: float, negative: int) -> np.ndarray | None:
+    """``u`` (an equilibrium whose tangent has ``negative`` negative eigenvalues) moved along the
+    eigenvector of the most negative eigenvalue (SciPy's shift-invert Lanczos about 0) by
+    SETTLE_PUSH × the model's size (largest translation), to the side on which the out-of-balance
+    force pushes on along it; None where the tangent is not symmetric or no negative eigenvalue
+    is found."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as spla
+
+    op = problem.op
+    _, Kr = problem.assembler.evaluate_reduced(u, op, forces=False)
+    K = sp.csc_matrix(Kr)
+    if K.shape[0] < negative + 3 or not linear.is_symmetric(K):
+        return None
+    try:
+        vals, vecs = spla.eigsh(K, k=min(negative + 2, K.shape[0] - 1), sigma=0.0, which="LM")
+    except (RuntimeError, spla.ArpackError, spla.ArpackNoConvergence):
+        return None
+    if vals.min() >= 0.0:
+        return None
+    phi = op.expand(vecs[:, int(np.argmin(vals))])
+    nodes = problem.model.mesh.nodes
+    size = float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0)))
+    phi *= SETTLE_PUSH * size / max(float(np.abs(phi[problem.dm.translations()]).max()), 1e-300)
+    Fext = problem.external(lam)
+
+    def outward(v: np.ndarray) -> float:  # the out-of-balance force along the push at u + v
+        f, _ = problem.assembler.evaluate(u + v, tangent=False)
+        return float(op.reduce(Fext - f) @ op.reduce(v))
+
+    return u + phi if outward(phi) >= outward(-phi) else u - phi
+
+
+def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
+           why: str = "") -> tuple[np.ndarray, NewtonResult]:
+    """The static equilibrium at the fixed load factor ``lam`` that the state ``u`` settles to
+    when every DOF is damped: pseudo-transient continuation (Kelley & Keyes 1998; the automatic
+    stabilisation of Abaqus/Standard is the same idea). Each pseudo-time increment Δt solves
+    f_int(u) + (D/Δt)(u − u_n) = F_ext(λ) by :func:`newton` (D = |diag K_r| at ``u``); Δt starts
+    at SETTLE_DT0, doubles after each converged increment and is quartered after a failed one.
+    With small Δt the damped tangent K_r + D/Δt is positive definite even where K_r is not (a
+    layer released beyond its buckling load), and the state moves along the energy's descent -
+    the snap a structure makes at a fixed load, without the inertia - instead of the jump of a
+    Newton step, which on the CFRP plate on 24 × 16 cycled through the contact sets of a
+    buckling sublaminate. An increment counts only where its damped tangent is positive definite
+    (else Δt is cut and capped): beyond 1/|μ| of an unstable mode μ implicit Euler damps that
+    mode instead of letting it grow and converges onto the saddle (the imperfect column at
+    1.5 P_E ended on its straight state). Once the damping force is below SETTLE_STATIC of the
+    load and the undamped tangent is positive definite (or its inertia unknown: a friction
+    tangent that is not symmetric), the damping is removed and a static Newton solve from there
+    must converge to a state with a positive definite tangent: the result is an equilibrium of
+    the undamped problem (its residual within ``tol_residual``), not a damped approximation. A
+    saddle is left by :func:`push_off_saddle`. The work of the out-of-balance force along the
+    path (the energy the snap released: the fall of the potential energy where the structure is
+    conservative) and the largest displacement change are recorded in
+    ``problem.interfaces.settlements`` (runner: a warning and summary.json 'settlements'; not in
+    the cohesive energy ledger, whose balance error then shows it). A result that is not
+    converged: the damped states did not settle (SETTLE_MAX_INCREMENTS, Δt below SETTLE_DT_MIN,
+    or back on a saddle after SETTLE_PUSHES pushes)."""
+    if not hasattr(problem, "pseudo"):
+        return u, NewtonResult(False, 0, message="pseudo-transient settling is not available in the distributed "
+                                                 "(PETSc) solver")
+    op = problem.op
+    u = problem.impose(u, lam)
+    u_start = u.copy()
+    _, Kr = problem.assembler.evaluate_reduced(u, op, forces=False)
+    D = np.abs(Kr.diagonal())
+    D = np.where(D > 0.0, D, D.max() if D.size and D.max() > 0 else 1.0)
+    scale = max(float(np.linalg.norm(op.reduce(problem.external(lam)))), 1e-3 * getattr(problem, "force_scale", 0.0),
+                1e-300)
+    s_in = replace(s, max_iterations=min(s.max_iterations, SETTLE_ITERATIONS),
+                   max_contact_iterations=min(s.max_contact_iterations, 4 * SETTLE_ITERATIONS))
+    total = NewtonResult(False, 0)
+    dt, cap, work, static_at, pushes = SETTLE_DT0, SETTLE_DT_MAX, 0.0, 0.0, 0
+    Fext = problem.external(lam)
+    gauss = (0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0))
+
+    def released(a: np.ndarray, b: np.ndarray) -> float:
+        """The work of the out-of-balance force F_ext − f_int along the segment from ``a`` to ``b``
+        (two-point Gauss: exact where f_int is cubic in u, Green-Lagrange strains with a linear
+        material); summed over the path, the energy the structure released (for a conservative
+        one, the fall of its potential energy)."""
+        d = b - a
+        return 0.5 * sum(float((Fext - problem.assembler.evaluate(a + x * d, tangent=False)[0]) @ d) for x in gauss)
+    message = f"the damped states did not settle in {SETTLE_MAX_INCREMENTS} pseudo-time increments"
+    for k in range(1, SETTLE_MAX_INCREMENTS + 1):
+        problem.pseudo = PseudoViscosity(D, u, 1.0 / dt)
+        try:
+            u_new, res = newton(problem, u, lam, s_in)
+            # a descent step only where the damped tangent there is positive definite: with Δt
+            # beyond 1/|μ| of an unstable mode μ, implicit Euler damps that mode instead of letting
+            # it grow, and the steps converge onto the saddle (unknown inertia: accepted)
+            descent = res.converged and (problem.inertia_at(u_new, s.backend) or 0) == 0
+        finally:
+            problem.pseudo = None
+        total = _joined(total, res)
+        if not descent:
+            if res.converged:
+                cap = 0.5 * dt  # Δt stays below an unstable mode's time scale from here
+            dt *= 0.25
+            if dt < SETTLE_DT_MIN:
+                message = f"no damped equilibrium even for a pseudo-time step of {dt:.1e} ({res.message})"
+                break
+            continue
+        dv = (u_new - u)[op.independent]
+        damping = D * dv / dt
+        work += released(u, u_new)
+        u = u_new
+        push: int | None = None  # the negative eigenvalues of a saddle to push off
+        if float(np.linalg.norm(damping)) <= SETTLE_STATIC * scale and dt >= 4.0 * static_at:
+            static_at = dt  # the next static try after Δt has grown fourfold
+            here = problem.inertia_at(u, s.backend)
+            if here:  # still near a saddle: flow on, pushed off where the flow has stopped there
+                if float(np.linalg.norm(damping)) <= 1e-6 * scale:
+                    push = here
+            else:
+                u_s, rs = newton(problem, u, lam, s)
+                total = _joined(total, rs)
+                negative = problem.inertia_at(u_s, s.backend) if rs.converged else None
+                if rs.converged:
+                    work += released(u, u_s)
+                    u = u_s
+                if negative:
+                    push = negative
+                elif rs.converged:
+                    total.converged, total.message = True, "settled"
+                    ctl = problem.interfaces
+                    if ctl is not None and hasattr(ctl, "settlements"):
+                        fraction = getattr(ctl, "debonded_fraction", None)
+                        ctl.settlements.append({
+                            "load_factor": float(lam), "increments": k, "iterations": total.iterations,
+                            "energy_released": work, "largest_displacement_change": float(np.abs(u_s - u_start).max()),
+                            "debonded_fraction": float(fraction()) if fraction is not None else None,
+                            "pushes": pushes, "reason": why})
+                    return u_s, total
+        if push is not None:
+            if pushes >= SETTLE_PUSHES:
+                message = f"it came back to an unstable equilibrium after {pushes} pushes off it"
+                break
+            pushed = push_off_saddle(problem, u, lam, push)
+            if pushed is None:
+                message = "it stopped at an unstable equilibrium whose unstable mode was not found"
+                break
+            work += released(u, pushed)
+            u, dt, static_at, pushes = pushed, SETTLE_DT0, 0.0, pushes + 1
+            continue
+        cap *= 1.25
+        dt = min(2.0 * dt, cap, SETTLE_DT_MAX)
+    total.converged, total.message = False, f"pseudo-transient settling failed: {message}"
+    return u, total
 
 
 def contact_hint(problem: Problem) -> str:

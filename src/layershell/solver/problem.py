@@ -44,6 +44,9 @@ class Problem:
     start_open: bool = field(default=False, repr=False)
     # the bond flags the constraint operator was built from (rebuild_constraints)
     op_bonded: dict = field(default_factory=dict, repr=False)
+    # the damping term of a pseudo-transient relaxation (solver/newton.py PseudoViscosity), added
+    # to every residual and tangent while set; None: the static problem
+    pseudo: object = field(default=None, repr=False)
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
@@ -108,6 +111,8 @@ class Problem:
         from .linear import SingularSystemError
 
         _, Kr = self.assembler.evaluate_reduced(u, self.op, forces=False)
+        if self.pseudo is not None:  # the damped tangent of a pseudo-transient increment
+            Kr = self.pseudo.tangent(Kr)
         sol = self.linear_solver(backend, "never")  # always factorises (kept: its symbolic analysis)
         try:
             sol.solve(Kr, np.zeros(Kr.shape[0]))

@@ -1,0 +1,112 @@
+"""Pseudo-transient settling at a fixed load (src/layershell/solver/newton.py ``settle``): the
+last resort of a re-solution after new releases, which cannot be cut into load increments.
+
+References, independent of the settling: the cantilever elastica (Timoshenko & Gere §2.7,
+tests/test_stability.py), the fall of the potential energy between the two states (a straight
+line integral of the internal forces, exact for Green-Lagrange strains with a linear material:
+f_int is cubic in u), and the inertia of the tangent (a stable state has no negative
+eigenvalue). The model: examples/column_buckling.toml with a lateral tip load of 10⁻⁵ P_E (the
+imperfection), whose Newton solves from its straight state beyond P_E converge onto the unstable
+branch that deflects against the imperfection, or not at all."""
+from __future__ import annotations
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from layershell.io.build import build, parse
+from layershell.solver import newton as nw
+from layershell.solver.problem import Problem
+from test_stability import B, L, P_EULER, T, column_text, elastica_deflection
+
+
+def column(nx: int, eps: float = 1e-5):
+    """(problem, equilibrium at 0.99 P_E, the tip's lateral DOF) of the imperfect column on
+    ``nx`` elements; the problem records settlements in a stand-in controller."""
+    text = column_text(nx, "factors = [1.0]") + f"""
+[[loads]]
+type = "edge"
+where = "near(x, {L})"
+direction = [0, 0, 1]
+distribution = {eps * P_EULER / (B * T)!r}
+"""
+    spec = build(parse(text))
+    pb = Problem.build(spec.model)
+    *_, last = nw.load_steps(pb, np.array([0.5, 0.99]), spec.newton)
+    pb.interfaces = SimpleNamespace(settlements=[])
+    tip = int(np.argmin(np.linalg.norm(spec.model.mesh.nodes - [L, 0.0, 0.0], axis=1)))
+    return pb, last.u, pb.dm.layer_dofs[0][tip, 0, 2], spec.newton
+
+
+def potential_fall(pb: Problem, a: np.ndarray, b: np.ndarray, lam: float) -> float:
+    """Π(a) − Π(b) at load factor ``lam``: the work of F_ext − f_int along the straight line from
+    ``a`` to ``b`` (three-point Gauss-Legendre, exact for a cubic f_int)."""
+    x, w = np.polynomial.legendre.leggauss(3)
+    d = b - a
+    F = pb.external(lam)
+    return sum(0.5 * wi * float((F - pb.assembler.evaluate(a + 0.5 * (xi + 1) * d, tangent=False)[0]) @ d)
+               for xi, wi in zip(x, w))
+
+
+def test_settling_beyond_the_buckling_load_reaches_the_stable_elastica_on_three_meshes():
+    """At 1.5 P_E, from the equilibrium at 0.99 P_E (nearly straight): Newton finds no
+    equilibrium in 25 iterations; settling reaches one whose tangent has no negative eigenvalue
+    and whose tip deflection is that of the elastica (|w|: measured +0.1 / +0.7 / +0.7 % on 4, 8
+    and 16 elements, the load-stepped path's −0.0 / +0.7 / +0.7 %, tests/test_stability.py). The
+    energy it reports released is the fall of the potential energy from the start to the end,
+    computed along a straight line instead of its damped path (measured to 10⁻¹²), and converges
+    with the mesh (3.658, 3.761, 3.768 N·mm)."""
+    ratios, energies = [], []
+    for nx in (4, 8, 16):
+        pb, u0, w_dof, s = column(nx)
+        _, plain = nw.newton(pb, u0, 1.5, s)
+        assert not plain.converged
+        u, res = nw.settle(pb, u0, 1.5, s, why="a test")
+        assert res.converged and res.message == "settled"
+        assert pb.inertia_at(u) == 0
+        (ev,) = pb.interfaces.settlements
+        assert ev["load_factor"] == 1.5 and ev["reason"] == "a test" and ev["increments"] > 1
+        assert ev["largest_displacement_change"] == pytest.approx(np.abs(u - u0).max())
+        assert ev["energy_released"] == pytest.approx(potential_fall(pb, u0, u, 1.5), rel=1e-8)
+        ratios.append(abs(u[w_dof]) / elastica_deflection(1.5))
+        energies.append(ev["energy_released"])
+    assert abs(ratios[0] - 1) < 0.02 and abs(ratios[1] - 1) < 0.01 and abs(ratios[2] - 1) < 0.01, ratios
+    assert abs(energies[2] - energies[1]) < abs(energies[1] - energies[0]), energies
+
+
+def test_settling_does_not_end_on_an_unstable_equilibrium():
+    """At 1.1 P_E Newton from the 0.99 P_E state converges onto the unstable near-straight branch
+    (w_tip −0.0089 mm, one negative eigenvalue). Settling from the same state ends on the
+    elastica instead: the steps whose damped tangent is not positive definite are refused (with
+    them implicit Euler damps the unstable mode and converges onto the saddle). Started on that
+    unstable equilibrium itself, where the damping force is zero, settling pushes off it along
+    its unstable mode (once) and ends on the elastica too; its potential energy lies below the
+    saddle's. Elastica at 1.1 P_E: 50.85 mm (8 elements: +0.3 %)."""
+    pb, u0, w_dof, s = column(8)
+    u_saddle, res = nw.newton(pb, u0, 1.1, s)
+    assert res.converged and pb.inertia_at(u_saddle) == 1 and abs(u_saddle[w_dof]) < 0.01
+    reference = elastica_deflection(1.1)
+    u, res = nw.settle(pb, u0, 1.1, s)
+    assert res.converged and pb.inertia_at(u) == 0
+    assert abs(u[w_dof]) == pytest.approx(reference, rel=0.01)
+    u, res = nw.settle(pb, u_saddle, 1.1, s)
+    assert res.converged and pb.inertia_at(u) == 0
+    assert abs(u[w_dof]) == pytest.approx(reference, rel=0.01)
+    ev = pb.interfaces.settlements[-1]
+    assert ev["pushes"] == 1
+    assert ev["energy_released"] == pytest.approx(potential_fall(pb, u_saddle, u, 1.1), rel=1e-8)
+    assert ev["energy_released"] > 0.0
+
+
+def test_settling_that_cannot_settle_says_why(monkeypatch):
+    """Where the damped increments do not settle within SETTLE_MAX_INCREMENTS the result is not
+    converged, names the reason, and records nothing."""
+    pb, u0, _, s = column(4)
+    monkeypatch.setattr(nw, "SETTLE_MAX_INCREMENTS", 3)
+    u, res = nw.settle(pb, u0, 1.5, s)
+    assert not res.converged
+    assert res.message == "pseudo-transient settling failed: the damped states did not settle in 3 pseudo-time increments"
+    assert pb.interfaces.settlements == []
+    assert math.isfinite(res.residuals[-1])
