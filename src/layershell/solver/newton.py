@@ -136,23 +136,32 @@ def locate_inertia_change(problem: Problem, s: NewtonSettings, u_a: np.ndarray, 
     return (lo, hi, u_lo) if (lo, hi) != (float(lam_a), float(lam_b)) else None
 
 
-def critical_mode(problem: Problem, u: np.ndarray) -> np.ndarray | None:
-    """The eigenvector of the reduced tangent at ``u`` whose eigenvalue lies nearest zero (SciPy's
-    shift-invert Lanczos, σ = 0), expanded to the full DOFs and scaled to a largest face
-    translation of 1: at a state just below a located bifurcation, its buckling mode. None where
-    the tangent is not symmetric or the eigensolver fails."""
+def modes_near_zero(problem: Problem, u: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ``k`` eigenpairs of the reduced tangent at ``u`` whose eigenvalues lie nearest zero
+    (SciPy's shift-invert Lanczos, σ = 0): (eigenvalues, reduced eigenvectors as columns). None
+    where the tangent is not symmetric, has no more than ``k`` rows, or the eigensolver fails."""
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
 
     _, Kr = problem.assembler.evaluate_reduced(u, problem.op, forces=False)
     K = sp.csc_matrix(Kr)
-    if K.shape[0] < 2 or not linear.is_symmetric(K):
+    if K.shape[0] <= k or not linear.is_symmetric(K):
         return None
     try:
-        _, vec = spla.eigsh(K, k=1, sigma=0.0, which="LM")
+        return spla.eigsh(K, k=k, sigma=0.0, which="LM")
     except (RuntimeError, spla.ArpackError, spla.ArpackNoConvergence):
         return None
-    phi = problem.op.expand(vec[:, 0])
+
+
+def critical_mode(problem: Problem, u: np.ndarray) -> np.ndarray | None:
+    """The eigenvector of the reduced tangent at ``u`` whose eigenvalue lies nearest zero (SciPy's
+    shift-invert Lanczos, σ = 0), expanded to the full DOFs and scaled to a largest face
+    translation of 1: at a state just below a located bifurcation, its buckling mode. None where
+    the tangent is not symmetric or the eigensolver fails."""
+    modes = modes_near_zero(problem, u, 1)
+    if modes is None:
+        return None
+    phi = problem.op.expand(modes[1][:, 0])
     dofs = problem.dm.translations()
     big = dofs[np.argmax(np.abs(phi[dofs]))]
     return phi / phi[big] if phi[big] != 0 else None
@@ -502,7 +511,7 @@ def newton_fixed_set(problem: Problem, u: np.ndarray, lam: float, s: NewtonSetti
     f, _ = asm.evaluate(u, tangent=False)
     best: tuple[float, np.ndarray | None] = (np.inf, None)
     for it in range(s.max_iterations + 1):
-        r = op.reduce(Fext - f) if pv is None else op.reduce(Fext - f) - pv.force(op, u)
+        r = _residual(problem, Fext, f, u)
         rn = float(np.linalg.norm(r))
         res.residuals.append(rn)
         if not np.isfinite(rn):
@@ -600,13 +609,16 @@ def record_scale(problem: Problem, scale: float) -> None:
         problem.force_scale = max(problem.force_scale, scale)
 
 
-def _residual_norm(problem: Problem, Fext: np.ndarray, f: np.ndarray, u: np.ndarray) -> float:
-    """‖Tᵀ(F_ext − f)‖, less the pseudo-transient damping force where it acts."""
+def _residual(problem: Problem, Fext: np.ndarray, f: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Tᵀ(F_ext − f) at ``u``, less the pseudo-transient damping force where it acts."""
     r = problem.op.reduce(Fext - f)
     pv = getattr(problem, "pseudo", None)
-    if pv is not None:
-        r = r - pv.force(problem.op, u)
-    return float(np.linalg.norm(r))
+    return r if pv is None else r - pv.force(problem.op, u)
+
+
+def _residual_norm(problem: Problem, Fext: np.ndarray, f: np.ndarray, u: np.ndarray) -> float:
+    """‖:func:`_residual`‖."""
+    return float(np.linalg.norm(_residual(problem, Fext, f, u)))
 
 
 def _line_search(problem: Problem, u: np.ndarray, dU: np.ndarray, Fext: np.ndarray, rn: float,
@@ -1007,20 +1019,11 @@ def push_off_saddle(problem: Problem, u: np.ndarray, lam: float, negative: int) 
     SETTLE_PUSH × the model's size (largest translation), to the side on which the out-of-balance
     force pushes on along it; None where the tangent is not symmetric or no negative eigenvalue
     is found."""
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as spla
-
     op = problem.op
-    _, Kr = problem.assembler.evaluate_reduced(u, op, forces=False)
-    K = sp.csc_matrix(Kr)
-    if K.shape[0] < negative + 3 or not linear.is_symmetric(K):
+    modes = modes_near_zero(problem, u, negative + 2)
+    if modes is None or modes[0].min() >= 0.0:
         return None
-    try:
-        vals, vecs = spla.eigsh(K, k=min(negative + 2, K.shape[0] - 1), sigma=0.0, which="LM")
-    except (RuntimeError, spla.ArpackError, spla.ArpackNoConvergence):
-        return None
-    if vals.min() >= 0.0:
-        return None
+    vals, vecs = modes
     phi = op.expand(vecs[:, int(np.argmin(vals))])
     nodes = problem.model.mesh.nodes
     size = float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0)))
@@ -1069,13 +1072,12 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
     _, Kr = problem.assembler.evaluate_reduced(u, op, forces=False)
     D = np.abs(Kr.diagonal())
     D = np.where(D > 0.0, D, D.max() if D.size and D.max() > 0 else 1.0)
-    scale = max(float(np.linalg.norm(op.reduce(problem.external(lam)))), 1e-3 * getattr(problem, "force_scale", 0.0),
-                1e-300)
+    Fext = problem.external(lam)
+    scale = max(float(np.linalg.norm(op.reduce(Fext))), 1e-3 * getattr(problem, "force_scale", 0.0), 1e-300)
     s_in = replace(s, max_iterations=min(s.max_iterations, SETTLE_ITERATIONS),
                    max_contact_iterations=min(s.max_contact_iterations, 4 * SETTLE_ITERATIONS))
     total = NewtonResult(False, 0)
     dt, cap, work, static_at, pushes = SETTLE_DT0, SETTLE_DT_MAX, 0.0, 0.0, 0
-    Fext = problem.external(lam)
     gauss = (0.5 - 0.5 / np.sqrt(3.0), 0.5 + 0.5 / np.sqrt(3.0))
 
     def released(a: np.ndarray, b: np.ndarray) -> float:
@@ -1105,16 +1107,15 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
                 message = f"no damped equilibrium even for a pseudo-time step of {dt:.1e} ({res.message})"
                 break
             continue
-        dv = (u_new - u)[op.independent]
-        damping = D * dv / dt
+        damping = float(np.linalg.norm(D * (u_new - u)[op.independent] / dt))  # = the static residual there
         work += released(u, u_new)
         u = u_new
         push: int | None = None  # the negative eigenvalues of a saddle to push off
-        if float(np.linalg.norm(damping)) <= SETTLE_STATIC * scale and dt >= 4.0 * static_at:
+        if damping <= SETTLE_STATIC * scale and dt >= 4.0 * static_at:
             static_at = dt  # the next static try after Δt has grown fourfold
             here = problem.inertia_at(u, s.backend)
             if here:  # still near a saddle: flow on, pushed off where the flow has stopped there
-                if float(np.linalg.norm(damping)) <= 1e-6 * scale:
+                if damping <= 1e-6 * scale:
                     push = here
             else:
                 u_s, rs = newton(problem, u, lam, s)
