@@ -671,6 +671,13 @@ def test_a_step_that_fails_after_complete_debonding_is_named_a_limit_point():
         return SimpleNamespace(interfaces=SimpleNamespace(debonded_fraction=lambda: fraction))
 
     assert "every interface point had debonded at load factor 0.3" in separated_hint(stand_in(1.0), 0.3)
+    # a re-solution that fails after the releases that completed the debonding (the CFRP plate on
+    # 24 × 16 at λ = 32): complete separation, not the contact rule
+    from layershell.solver.newton import NewtonResult, reequilibration_error
+    failed = NewtonResult(False, 3, residuals=[1.0], message="pseudo-transient settling failed")
+    done = str(reequilibration_error(stand_in(1.0), 7, 32.0, failed))
+    assert "step 7: re-equilibration at load factor 32 failed" in done and "complete separation at load factor 32" in done
+    assert "complete separation" not in str(reequilibration_error(stand_in(0.9), 7, 32.0, failed))
     assert separated_hint(stand_in(0.999), 0.3) == ""
     assert separated_hint(SimpleNamespace(interfaces=None), 0.3) == ""
     pb = _slip_plate()  # bonded at the start: nothing debonded
