@@ -145,3 +145,18 @@ def test_damped_increments_reach_the_static_equilibrium_where_a_static_solve_onl
     f, _ = pb.assembler.evaluate(u, tangent=False)
     F = pb.external(1.5)
     assert np.linalg.norm(pb.op.reduce(F - f)) <= s.tol_residual * np.linalg.norm(pb.op.reduce(F))
+
+
+def test_the_damped_tangent_keeps_the_pattern_of_the_tangent():
+    """PseudoViscosity.tangent adds D/Δt on the diagonal of K_r in K_r's own pattern (the solver
+    keeps its symbolic analysis and upper-triangle map): equal to K_r + diag(D/Δt) entry for
+    entry (to the last bit of the product), the same index arrays, and K_r itself unchanged."""
+    import scipy.sparse as sp
+
+    pb, u0, _, _ = column(4)
+    _, Kr = pb.assembler.evaluate_reduced(u0, pb.op, forces=False)
+    D = np.abs(Kr.diagonal()) * np.linspace(0.5, 2.0, Kr.shape[0])
+    damped = nw.PseudoViscosity(D, u0, 1.0 / 3.0).tangent(Kr)
+    assert damped.indices is Kr.indices and damped.indptr is Kr.indptr
+    assert abs(damped - (Kr + sp.diags(D / 3.0))).max() <= 1e-15 * abs(Kr).max()  # (1/3)·D against D/3
+    assert np.array_equal(Kr.diagonal(), pb.assembler.evaluate_reduced(u0, pb.op, forces=False)[1].diagonal())  # K_r untouched

@@ -200,6 +200,16 @@ class ReducedScatter:
         contribution is symmetric by construction (no check needed by the solver)."""
         return self.matrix_from_values(self.P @ data_full, symmetric)
 
+    def diagonal_positions(self) -> np.ndarray | None:
+        """The positions of the diagonal entries in the data of this pattern (cached; None where a
+        row stores no diagonal entry)."""
+        if not hasattr(self, "_diagonal"):
+            n = self.shape[0]
+            rows = np.repeat(np.arange(n), np.diff(self.indptr))
+            pos = np.flatnonzero(rows == self.indices)
+            self._diagonal = pos if pos.size == n else None
+        return self._diagonal
+
     def matrix_from_values(self, data_reduced: np.ndarray, symmetric: bool = False) -> "ReducedTangent":
         """K_r with the values ``data_reduced`` of this pattern."""
         K = ReducedTangent((data_reduced, self.indices, self.indptr), shape=self.shape)

@@ -1017,8 +1017,18 @@ class PseudoViscosity:
         return self.rate * self.diag * (u[ind] - self.u_n[ind])
 
     def tangent(self, Kr):
+        """K_r + D/Δt; in K_r's own pattern where it knows it (assembly.ReducedTangent), so that
+        the solver keeps its symbolic analysis and upper-triangle map (a new CSR matrix per
+        iteration cost the CFRP plate on 24 × 16 about 40 % of each settling iteration: a
+        symbolic analysis every other solve, a sort and a symmetry check every solve)."""
         import scipy.sparse as sp
 
+        rs = getattr(Kr, "scatter", None)
+        pos = rs.diagonal_positions() if rs is not None else None
+        if pos is not None and Kr.indices is rs.indices and Kr.indptr is rs.indptr:
+            data = Kr.data.copy()
+            data[pos] += self.rate * self.diag
+            return rs.matrix_from_values(data, symmetric=getattr(Kr, "known_symmetric", False))
         return Kr + sp.diags(self.rate * self.diag, format="csr")
 
 
