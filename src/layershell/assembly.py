@@ -201,14 +201,12 @@ class ReducedScatter:
         return self.matrix_from_values(self.P @ data_full, symmetric)
 
     def diagonal_positions(self) -> np.ndarray | None:
-        """The positions of the diagonal entries in the data of this pattern (cached; None where a
-        row stores no diagonal entry)."""
-        if not hasattr(self, "_diagonal"):
-            n = self.shape[0]
-            rows = np.repeat(np.arange(n), np.diff(self.indptr))
-            pos = np.flatnonzero(rows == self.indices)
-            self._diagonal = pos if pos.size == n else None
-        return self._diagonal
+        """The positions of the diagonal entries in the data of this pattern: the first entry of
+        each row of the upper-triangle map (sorted indices); None where a row stores no diagonal
+        entry (``upper_indices`` None)."""
+        if self.upper_indices is None:
+            return None
+        return self.upper_pos[self.upper_indptr[:-1]]
 
     def matrix_from_values(self, data_reduced: np.ndarray, symmetric: bool = False) -> "ReducedTangent":
         """K_r with the values ``data_reduced`` of this pattern."""

@@ -1019,8 +1019,9 @@ class PseudoViscosity:
     def tangent(self, Kr):
         """K_r + D/Δt; in K_r's own pattern where it knows it (assembly.ReducedTangent), so that
         the solver keeps its symbolic analysis and upper-triangle map (a new CSR matrix per
-        iteration cost the CFRP plate on 24 × 16 about 40 % of each settling iteration: a
-        symbolic analysis every other solve, a sort and a symmetry check every solve)."""
+        iteration made the solver repeat its symbolic analysis every other solve, and sort and
+        check the symmetry every solve: four damped increments of the CFRP plate on 24 × 16,
+        16 iterations, took 35.0 s that way against 26.2 s now)."""
         import scipy.sparse as sp
 
         rs = getattr(Kr, "scatter", None)
