@@ -160,3 +160,67 @@ def test_the_damped_tangent_keeps_the_pattern_of_the_tangent():
     assert damped.indices is Kr.indices and damped.indptr is Kr.indptr
     assert abs(damped - (Kr + sp.diags(D / 3.0))).max() <= 1e-15 * abs(Kr).max()  # (1/3)·D against D/3
     assert np.array_equal(Kr.diagonal(), pb.assembler.evaluate_reduced(u0, pb.op, forces=False)[1].diagonal())  # K_r untouched
+
+
+def free_column(nx: int = 4):
+    """(problem, zero state, z DOFs of the reference face) of the column of :func:`column` whose
+    clamp holds x and y only: a rigid translation in z costs no energy, and the lateral tip load
+    (10⁻² P_E) has no equilibrium, at any load factor."""
+    text = column_text(nx, "factors = [1.0]").replace('components = ["x", "y", "z"]', 'components = ["x", "y"]')
+    assert 'components = ["x", "y"]' in text
+    text += f"""
+[[loads]]
+type = "edge"
+where = "near(x, {L})"
+direction = [0, 0, 1]
+distribution = {1e-2 * P_EULER / (B * T)!r}
+"""
+    spec = build(parse(text))
+    pb = Problem.build(spec.model)
+    pb.interfaces = SimpleNamespace(settlements=[])
+    z = pb.dm.layer_dofs[0][:, 0, 2]
+    return pb, np.zeros(pb.dm.n_full), z[z >= 0], spec.newton
+
+
+def test_settling_stops_early_where_the_state_moves_without_stiffness(monkeypatch):
+    """A mechanism has no equilibrium: the column free to translate in z under a lateral load
+    (at 0.5 P_E). Settling says so ("no equilibrium: the state moves without stiffness") once
+    the damping force has stopped falling while Δt grew and the state has moved farther than
+    the model's size - a rigid translation in z (every node within 1 % of the mean). Without
+    the rule it runs to SETTLE_MAX_INCREMENTS (the completely debonded CFRP plate on 24 × 16
+    did, its loose sublaminate drifting 5·10⁵ mm), at more than five times the iterations."""
+    pb, u0, z, s = free_column()
+    u, res = nw.settle(pb, u0, 0.5, s)
+    assert not res.converged and pb.interfaces.settlements == []
+    assert res.message.startswith("pseudo-transient settling failed: no equilibrium: the state moves without stiffness")
+    assert "more than the model's size 100" in res.message
+    drift = u[z]
+    assert drift.mean() > 100.0 and np.ptp(drift) < 0.01 * drift.mean()
+    monkeypatch.setattr(nw, "SETTLE_RUNAWAY", 10**9)
+    _, without = nw.settle(pb, u0, 0.5, s)
+    assert not without.converged and "did not settle in 200 pseudo-time increments" in without.message
+    assert without.iterations > 5 * res.iterations
+
+
+def test_the_stiffness_free_signature_on_a_damped_linear_mode():
+    """moves_without_stiffness on one mode damped as settle damps it (implicit Euler with Δt
+    doubling from 1: u ← u + (F − k u) Δt / (D + k Δt), damping force D (u − u_n)/Δt): with
+    k = 0 the force never falls and the signature shows after SETTLE_RUNAWAY increments and
+    stays; with k = 10⁻⁴ D it shows only while kΔt is small (up to Δt = 2¹¹, kΔt = 0.2: the
+    stiffness is not yet felt) and is gone for good from Δt = 2¹², while the motion stays below
+    F/k, the mode's equilibrium - settle stops only where the state has also moved farther than
+    the model's size."""
+    def history(k: float, n: int = 40) -> tuple[list[bool], float]:
+        D, F, u, dt, hist, shows = 1.0, 1.0, 0.0, 1.0, [], []
+        for _ in range(n):
+            du = (F - k * u) * dt / (D + k * dt)
+            hist.append((dt, D * du / dt))
+            u += du
+            shows.append(nw.moves_without_stiffness(hist))
+            dt = min(2.0 * dt, nw.SETTLE_DT_MAX)
+        return shows, u
+
+    free, _ = history(0.0)
+    assert free == [False] * nw.SETTLE_RUNAWAY + [True] * (40 - nw.SETTLE_RUNAWAY)
+    stiff, u = history(1e-4)
+    assert any(stiff[:12]) and not any(stiff[12:]) and u == pytest.approx(1e4, rel=1e-6)

@@ -1000,6 +1000,15 @@ SETTLE_STATIC = 1e-2
 # 1.1 P_E: one push, then the elastica; tests/test_settle.py)
 SETTLE_PUSH = 1e-3
 SETTLE_PUSHES = 3
+# ... and where the state moves without stiffness it stops early, without an equilibrium: over
+# the last SETTLE_RUNAWAY converged increments Δt grew at least SETTLE_RUNAWAY_GROWTH-fold (or
+# reached SETTLE_DT_MAX) while the damping force fell less than SETTLE_RUNAWAY_FALL-fold, and
+# the state has moved farther than the model's size from where the settling started (the
+# completely debonded CFRP plate on 24 × 16: its loose sublaminate drifted 5·10⁵ mm under a
+# constant damping force, and the settling ran on to its 200th increment; tests/test_settle.py)
+SETTLE_RUNAWAY = 6
+SETTLE_RUNAWAY_GROWTH = 8.0
+SETTLE_RUNAWAY_FALL = 2.0
 
 
 @dataclass
@@ -1033,6 +1042,26 @@ class PseudoViscosity:
         return Kr + sp.diags(self.rate * self.diag, format="csr")
 
 
+def model_size(problem: Problem) -> float:
+    """The diagonal of the bounding box of the mesh's nodes (the model's size)."""
+    nodes = problem.model.mesh.nodes
+    return float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0)))
+
+
+def moves_without_stiffness(history: list[tuple[float, float]]) -> bool:
+    """Whether the damped increments move without stiffness: ``history`` holds (Δt, damping
+    force) of the consecutive converged increments; over the last SETTLE_RUNAWAY of them Δt grew
+    SETTLE_RUNAWAY_GROWTH-fold (or reached SETTLE_DT_MAX) while the damping force fell less than
+    SETTLE_RUNAWAY_FALL-fold. An implicit Euler increment Δt cuts the damping force of a mode of
+    stiffness k and damping D by 1 + kΔt/D, so a force that did not halve while Δt grew to Δt_1
+    leaves k < D/Δt_1 (the last increment's factor alone stayed below 2): along that motion the
+    tangent has next to no stiffness (D/Δt_1 ≤ 10⁻¹² D at the bound of Δt)."""
+    if len(history) <= SETTLE_RUNAWAY:
+        return False
+    (dt0, f0), (dt1, f1) = history[-SETTLE_RUNAWAY - 1], history[-1]
+    return f1 * SETTLE_RUNAWAY_FALL > f0 and (dt1 >= SETTLE_RUNAWAY_GROWTH * dt0 or dt1 >= SETTLE_DT_MAX)
+
+
 def push_off_saddle(problem: Problem, u: np.ndarray, lam: float, negative: int) -> np.ndarray | None:
     """``u`` (an equilibrium whose tangent has ``negative`` negative eigenvalues) moved along the
     eigenvector of the most negative eigenvalue (SciPy's shift-invert Lanczos about 0) by
@@ -1045,9 +1074,7 @@ def push_off_saddle(problem: Problem, u: np.ndarray, lam: float, negative: int) 
         return None
     vals, vecs = modes
     phi = op.expand(vecs[:, int(np.argmin(vals))])
-    nodes = problem.model.mesh.nodes
-    size = float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0)))
-    phi *= SETTLE_PUSH * size / max(float(np.abs(phi[problem.dm.translations()]).max()), 1e-300)
+    phi *= SETTLE_PUSH * model_size(problem) / max(float(np.abs(phi[problem.dm.translations()]).max()), 1e-300)
     Fext = problem.external(lam)
 
     def outward(v: np.ndarray) -> float:  # the out-of-balance force along the push at u + v
@@ -1087,7 +1114,8 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
     ``problem.interfaces.settlements`` (runner: a warning and summary.json 'settlements'; not in
     the cohesive energy ledger, whose balance error then shows it). A result that is not
     converged: the damped states did not settle (SETTLE_MAX_INCREMENTS, Δt below SETTLE_DT_MIN,
-    or back on a saddle after SETTLE_PUSHES pushes)."""
+    or back on a saddle after SETTLE_PUSHES pushes), or they move without stiffness
+    (:func:`moves_without_stiffness`) and have left the model's size behind: no equilibrium."""
     if not hasattr(problem, "pseudo"):
         return u, NewtonResult(False, 0, message="pseudo-transient settling is not available in the distributed "
                                                  "(PETSc) solver")
@@ -1113,6 +1141,7 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
         d = b - a
         return 0.5 * sum(float((Fext - problem.assembler.evaluate(a + x * d, tangent=False)[0]) @ d) for x in gauss)
     message = f"the damped states did not settle in {SETTLE_MAX_INCREMENTS} pseudo-time increments"
+    size, translations, history = model_size(problem), problem.dm.translations(), []
     for k in range(1, SETTLE_MAX_INCREMENTS + 1):
         problem.pseudo = PseudoViscosity(D, u, 1.0 / dt)
         try:
@@ -1135,6 +1164,16 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
         damping = float(np.linalg.norm(D * (u_new - u)[op.independent] / dt))  # = the static residual there
         work += released(u, u_new)
         u = u_new
+        history.append((dt, damping))
+        moved = float(np.abs((u - u_start)[translations]).max()) if translations.size else 0.0
+        if moved > size and moves_without_stiffness(history):
+            dt0, f0 = history[-SETTLE_RUNAWAY - 1]
+            message = (f"no equilibrium: the state moves without stiffness (over the last {SETTLE_RUNAWAY} pseudo-time "
+                       f"increments the step grew from {dt0:.1e} to {dt:.1e} while the out-of-balance force stayed at "
+                       f"{f0 / scale:.1e} -> {damping / scale:.1e} of the load), and it has moved {moved:.3g} from "
+                       f"where it started, more than the model's size {size:.3g}: a part of the model that nothing "
+                       f"holds (a mechanism, or a layer that has debonded completely) runs away under the load")
+            break
         push: int | None = None  # the negative eigenvalues of a saddle to push off
         if (damping <= SETTLE_STATIC * scale and dt >= 4.0 * static_at) or damping <= s.tol_residual * scale:
             static_at = dt  # the next static try after Δt has grown fourfold
@@ -1172,6 +1211,7 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
                 break
             work += released(u, pushed)
             u, dt, static_at, pushes = pushed, SETTLE_DT0, 0.0, pushes + 1
+            history.clear()
             continue
         cap *= 1.25
         dt = min(2.0 * dt, cap, SETTLE_DT_MAX)
