@@ -5,9 +5,11 @@ thesis's law) on the meshes given and prints first damage / first full debonding
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 6 12 24 [--thesis] [--beyond]
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 24 --element mitc --reuse never
     PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 6 12 --only-thesis strong,weak,slip --rule lobatto
+    PYTHONPATH=src python benchmarks/cohesive_plate_mesh.py 3 6 12 --element mitc --arc
 
 ``--beyond``: load past the design load to λ = 1.2 (steps of 0.1 to 0.9, then 0.01), where the
 interface debonds completely at a first point (first_delamination_load_factor).
+``--arc``: traced by arc length (``[steps] control = "arc_length"``) instead of load steps.
 ``--element mitc``: the MITC9 element instead of the example's; ``--reuse never|always``: the
 linear solver's ``[steps] reuse_factorization`` (default auto: GMRES on kept factorisations;
 the printed ``linear_solves`` count them). ``--only-thesis CASES``: the thesis-law plates
@@ -28,7 +30,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 
 
 def study(name: str, n: int, beyond: bool = False, element: str | None = None, reuse: str | None = None,
-          rule: str | None = None) -> dict:
+          rule: str | None = None, arc: bool = False) -> dict:
     path = EXAMPLES / f"{name}.toml"
     text = path.read_text()
     if rule is not None:
@@ -41,11 +43,14 @@ def study(name: str, n: int, beyond: bool = False, element: str | None = None, r
     if beyond:
         factors = [round(0.1 * i, 4) for i in range(1, 10)] + [round(0.9 + 0.01 * i, 4) for i in range(1, 31)]
         text = text.replace("[steps]\nn = 24", f"[steps]\nfactors = {factors}")
+    if arc:
+        text = text.replace("[steps]\n", '[steps]\ncontrol = "arc_length"\n', 1)
     if reuse is not None:
         text = text.replace("[steps]\n", f'[steps]\nreuse_factorization = "{reuse}"\n', 1)
     t0, c0 = time.perf_counter(), time.process_time()
     s = run(build(parse(text, str(path)), path.parent), None, write_vtu=False).summary
     return {"mesh": f"{n}x{n}", "lambda_end": s["steps"][-1]["load_factor"] if s["steps"] else 0.0,
+            "increments": len(s["steps"]), "path_end": s.get("path_end"),
             "first_damage": s.get("first_damage_load_factor"),
             "first_delamination": s.get("first_delamination_load_factor"),
             "w_front_max": s["probes"].get("w_front_max"), "wall_s": round(time.perf_counter() - t0, 1),
@@ -71,7 +76,7 @@ def main(argv: list[str]) -> None:
     for name in names:
         print(name)
         for n in meshes:
-            print("  ", study(name, n, "--beyond" in argv, **opts), flush=True)
+            print("  ", study(name, n, "--beyond" in argv, arc="--arc" in argv, **opts), flush=True)
 
 
 if __name__ == "__main__":

@@ -109,6 +109,34 @@ def test_arc_length_on_the_mitc9_plate_goes_forward():
     assert s["first_damage_load_factor"] < lam[-1]
 
 
+def test_arc_length_past_a_snap_back_reloads_onto_the_load_controlled_state():
+    """The example's plate (friction μ0 = 0.95) with MITC9 on 3 × 3 by arc length. Its process
+    zone spans 1.2 node spacings (warned): at λ = 0.861 a node row of the flap debonds and the
+    path snaps back, in one dissipation-controlled increment, to λ = 0.387 (0.5 m² debonded).
+    There the dissipation constraint finds no solution at any size (nothing is left to damage
+    nearby), and the arc length takes over. It used to keep the previous increment's direction,
+    down the snap-back, so it followed elastic unloading to λ = 0.02 and the run stopped with
+    "the path unloads without damage". Its direction now comes from the work criterion, as after
+    an increment that could not dissipate: the damaged plate reloads to λ = 1 and ends on the
+    state that load control reaches on the same mesh (the flap debonded in one step there):
+    w_front_max equal to 10⁻⁹ (measured 1.6·10⁻¹³)."""
+    import numpy as np
+
+    mesh = {'element = "full"': 'element = "mitc"', "nx = 6": "nx = 3", "ny = 6": "ny = 3"}
+    loaded = run_example("cantilever_plate_cohesive", mesh).summary
+    traced = run_example("cantilever_plate_cohesive", {
+        **mesh, "[steps]\nn = 24": '[steps]\nn = 24\ncontrol = "arc_length"\nmax_steps = 100'}).summary
+    assert traced["converged"] and traced["path_end"] == "lambda_end"
+    lam = np.array([st["load_factor"] for st in traced["steps"]])
+    top = int(np.argmax(lam))
+    assert lam[top] == pytest.approx(1.0) and lam.min() < 1.0
+    k = int(np.argmax(lam[:top] > 0.8))  # the snap-back: a fall of more than 40 % of the peak, then the rise
+    assert lam[k:top].min() < 0.5 * lam[:top].max() and lam[:top].max() > 0.8
+    assert traced["probes"]["w_front_max"] == pytest.approx(loaded["probes"]["w_front_max"], rel=1e-9)
+    area = [s["debonded_area"][-1]["concrete/trc"] for s in (loaded, traced)]
+    assert area[0] == area[1] > 0
+
+
 def test_arc_weights_are_lengths():
     """``full_weights``: t^l per DOF of director l (t the layer's thickness at the node); with
     them an increment of the director coefficients is measured by how far it moves the layer's

@@ -865,7 +865,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     allow_jump = True  # cutting does not help: accept the jump, with a warning
                     continue
                 if st.mode == "dissipation":  # once per increment: then the arc length alone
-                    st.mode, st.size = "arc", st.arc_length
+                    # its direction by the work criterion, as after "no dissipation" above: past a
+                    # snap-back the previous direction follows elastic unloading down to λ = 0
+                    st.mode, st.size, st.changed = "arc", st.arc_length, True
                     cuts, tried_dissipation = 0, True
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
