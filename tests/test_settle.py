@@ -224,3 +224,39 @@ def test_the_stiffness_free_signature_on_a_damped_linear_mode():
     assert free == [False] * nw.SETTLE_RUNAWAY + [True] * (40 - nw.SETTLE_RUNAWAY)
     stiff, u = history(1e-4)
     assert any(stiff[:12]) and not any(stiff[12:]) and u == pytest.approx(1e4, rel=1e-6)
+
+
+def test_a_layer_pulled_off_completely_ends_the_run_naming_no_equilibrium_and_complete_separation(tmp_path):
+    """End to end: the §5.1 plate (examples/cantilever_plate_strong.toml, 3 × 3) with its TRC
+    layer pulled up by a load on its top face (10 kN/m², λ = 0.25 in the first of 4 steps) and
+    interface strengths of 1 kN/m², so that the first step's releases debond every interface
+    point. The loose layer, held by nothing (contact only pushes), has no equilibrium: its
+    re-solution fails, settling stops on the motion without stiffness, and the run ends naming
+    both (no equilibrium, complete separation at λ = 0.25); the command line's advice says that
+    this is the end of the debonding, not the generic hint about supports and step sizes."""
+    from typer.testing import CliRunner
+
+    from helpers import EXAMPLES
+    from layershell.cli import app
+    from layershell.runner import run
+
+    text = (EXAMPLES / "cantilever_plate_strong.toml").read_text()
+    for a, b in (("sigma_max = 1980.0", "sigma_max = 1.0"), ("tau_max = 1210.0", "tau_max = 1.0"),
+                 ("[steps]\nn = 24", "[steps]\nn = 4"),
+                 ("[[interfaces]]", '[[loads]]\ntype = "surface"\nface = "top"\ndirection = [0, 0, 1]\n'
+                                    'magnitude = 10.0\n\n[[interfaces]]')):
+        assert a in text
+        text = text.replace(a, b, 1)
+    r = run(build(parse(text)), None, write_vtu=False)
+    assert not r.converged and r.summary["steps"] == []
+    assert "re-equilibration at load factor 0.25 failed" in r.message
+    assert "no equilibrium: the state moves without stiffness" in r.message
+    assert "the run has reached complete separation at load factor 0.25" in r.message
+    model = tmp_path / "pulled_off.toml"
+    model.write_text(text)
+    res = CliRunner().invoke(app, ["run", str(model), "--out", str(tmp_path / "out"), "--no-vtu", "--quiet"],
+                             env={"LAYERSHELL_TRACEBACK": None, "NO_COLOR": "1"})
+    assert res.exit_code == 1
+    said = " ".join(res.stderr.split())
+    assert "complete separation" in said and "the end of the debonding" in said
+    assert "check that the supports prevent" not in said

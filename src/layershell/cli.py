@@ -372,6 +372,10 @@ def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
         cause = ("the stiffness matrix is singular, usually because the supports leave a rigid-body motion free: "
                  "supports must prevent every rigid-body motion (3 translations and 3 rotations), so check "
                  "'supports'")
+    elif "the run has reached complete separation" in msg:  # solver/newton.py separated_hint
+        cause = ("every interface point had debonded, so the layers part: that is the end of the debonding, not a "
+                 "fault of the model or of the step size (where it comes earlier than expected, check the "
+                 "interfaces' strengths and the loads on the loose layer)")
     elif "the regularisation, not the interface, carries the load" in msg:  # stabilised (solver/newton.py)
         cause = "the load factors beyond the limit point are not equilibrium states of the rate-independent law"
     else:
