@@ -103,8 +103,11 @@ def trace(L: float = L0, h: float = 10.0, until: str = "peak", extra: dict[str, 
             if until == "end" and P < 0.01 * P_U and max(out["P"]) > 0.5 * P_U:
                 break
     except ConvergenceError as exc:
-        # with friction the path past the peak unloads without damage (λ from 1.011 to 0.765 in
-        # one increment): the arc length stops there (arclength.unloading), after the peak
+        # with friction the path past the peak used to unload without damage (λ from 1.011 to
+        # 0.765 in one increment) and the arc length stopped there (arclength.unloading), after
+        # the peak; on 29 Nov 2026 it followed the falling branch to 3 % below the peak (61 states
+        # before the arc length's direction after a failed dissipation constraint came from the
+        # work criterion, 144 after). A stop past the peak is still accepted here
         if until != "peak" or "unloads without damage" not in str(exc) or len(out["P"]) < 3:
             raise
         out["stopped"] = str(exc)
