@@ -308,10 +308,10 @@ def test_contact_iteration_cap_from_the_model_file(monkeypatch):
     load step's own budget of 8, which this test used before, no longer makes it fail
     everywhere), the re-solution fails; pseudo-transient settling (newton.settle) then finds the
     equilibrium that the full budget finds (w_front_max to 10⁻⁹; measured 3·10⁻¹⁵), and
-    summary.json 'settlements' and a warning say so. Without settling the run stops with a message that names
-    the setting, and the converged step is kept; with the rule left open the contact moves to
-    the nodes there (contact_to_nodes), the run reaches its end, and summary.json and a warning
-    say where."""
+    summary.json 'settlements' and a warning say so. Without settling the run stops with a
+    message that names the setting, and the converged step is kept; with the rule left open the
+    contact moves to the nodes there (contact_to_nodes), the run reaches its end, and
+    summary.json and a warning say where."""
     from dataclasses import replace
 
     from layershell.runner import ContactRuleWarning, JumpWarning
@@ -638,9 +638,10 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     default (with the default budget, REEQUILIBRATION_BUDGET = 4) starts at the Gauss points,
     moves to the nodes where a re-solution's contact set cycles (a set frozen for the third
     time, at λ = 0.5; contact_to_nodes; with the libraries of 29 Nov 2026 a set still changing
-    after the allowed loops, its last state violating the contact condition) and reaches λ = 1 with the nodal rule's deflection. The
-    criterion stays at the Gauss points: the first debonding (λ = 0.125 on 12 × 12; the thesis
-    law's onset falls with the mesh) is the same on every rule."""
+    after the allowed loops, its last state violating the contact condition) and reaches λ = 1
+    with the nodal rule's deflection. The criterion stays at the Gauss points: the first
+    debonding (λ = 0.125 on 12 × 12; the thesis law's onset falls with the mesh) is the same on
+    every rule."""
     from layershell.solver import newton
 
     moved = run_example("cantilever_plate_slip", REFINED)

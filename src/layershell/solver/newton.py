@@ -1042,12 +1042,6 @@ class PseudoViscosity:
         return Kr + sp.diags(self.rate * self.diag, format="csr")
 
 
-def model_size(problem: Problem) -> float:
-    """The diagonal of the bounding box of the mesh's nodes (the model's size)."""
-    nodes = problem.model.mesh.nodes
-    return float(np.linalg.norm(nodes.max(axis=0) - nodes.min(axis=0)))
-
-
 def moves_without_stiffness(history: list[tuple[float, float]]) -> bool:
     """Whether the damped increments move without stiffness: ``history`` holds (Δt, damping
     force) of the consecutive converged increments; over the last SETTLE_RUNAWAY of them Δt grew
@@ -1074,7 +1068,7 @@ def push_off_saddle(problem: Problem, u: np.ndarray, lam: float, negative: int) 
         return None
     vals, vecs = modes
     phi = op.expand(vecs[:, int(np.argmin(vals))])
-    phi *= SETTLE_PUSH * model_size(problem) / max(float(np.abs(phi[problem.dm.translations()]).max()), 1e-300)
+    phi *= SETTLE_PUSH * problem.model.mesh.size() / max(float(np.abs(phi[problem.dm.translations()]).max()), 1e-300)
     Fext = problem.external(lam)
 
     def outward(v: np.ndarray) -> float:  # the out-of-balance force along the push at u + v
@@ -1141,7 +1135,7 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
         d = b - a
         return 0.5 * sum(float((Fext - problem.assembler.evaluate(a + x * d, tangent=False)[0]) @ d) for x in gauss)
     message = f"the damped states did not settle in {SETTLE_MAX_INCREMENTS} pseudo-time increments"
-    size, translations, history = model_size(problem), problem.dm.translations(), []
+    size, translations, history = problem.model.mesh.size(), problem.dm.translations(), []
     for k in range(1, SETTLE_MAX_INCREMENTS + 1):
         problem.pseudo = PseudoViscosity(D, u, 1.0 / dt)
         try:
@@ -1165,7 +1159,7 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
         work += released(u, u_new)
         u = u_new
         history.append((dt, damping))
-        moved = float(np.abs((u - u_start)[translations]).max()) if translations.size else 0.0
+        moved = float(np.abs((u - u_start)[translations]).max())
         if moved > size and moves_without_stiffness(history):
             dt0, f0 = history[-SETTLE_RUNAWAY - 1]
             message = (f"no equilibrium: the state moves without stiffness (over the last {SETTLE_RUNAWAY} pseudo-time "
