@@ -898,6 +898,54 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
             steps[0].state.lam_damaged)
 
 
+def test_an_arc_increment_that_unloads_elastically_from_a_debonding_state_is_refused(monkeypatch):
+    """From a state whose increment damaged an interface, an arc-length increment in which the load
+    and its conjugate displacement fall while the ledger books no damage has found the elastic
+    unloading branch (both are equilibria there): refused, and the dissipation constraint, which
+    demands damage, takes the increment. On CI (2 threads) the MMB on 100 elements, its crack past
+    the load point, went so from λ = 0.6078 to 0.6007 (the work criterion's direction at an
+    indefinite tangent) and on down, 'unloads without damage', while on 1 thread it reached λ = 1.
+    From a state whose increment did not damage (here: none did), the same increment is
+    accepted. Stand-ins: the arc length converges with λ and u falling, booking nothing; the
+    dissipation constraint with λ rising, booking damage."""
+    from types import SimpleNamespace
+
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonSettings
+
+    booked = {"damage": 0.0}
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        tried.append(mode)
+        if mode == "dissipation":
+            booked["damage"] += 1.0
+            return al.Attempt(True, u + 1e-3, lam + 0.01, 3, [1e-10])
+        return al.Attempt(True, u - 1e-3, lam - 0.01, 3, [1e-10])
+
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]))
+    itf = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
+    pb = SimpleNamespace(interfaces=itf, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None, snapshot=lambda: dict(booked), restore=booked.update,
+                         op=SimpleNamespace(independent=np.arange(2)))
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
+    for lam_damaged, expected, modes in ((0.5, 0.51, ["arc", "dissipation"]), (float("nan"), 0.49, ["arc"])):
+        booked["damage"], tried[:] = 0.0, []
+        st0 = al.PathState(mode="arc", size=0.1, arc_length=0.1, lam_peak=0.6, arc_length0=1.0, changed=True,
+                           lam_damaged=lam_damaged)
+        steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                                   on_step_end=lambda problem, u, lam: False))
+        assert [s.load_factor for s in steps] == pytest.approx([expected]) and tried == modes
+    # the check itself: the load and F̂·Δu fall, no damage booked since the start's ledger
+    assert al.elastic_unloading(pb, -0.01, -np.ones(2), (0.0, booked["damage"]))
+    assert not al.elastic_unloading(pb, -0.01, np.ones(2), (0.0, booked["damage"]))  # the displacement grows
+    assert not al.elastic_unloading(pb, +0.01, -np.ones(2), (0.0, booked["damage"]))  # the load rises
+    assert not al.elastic_unloading(pb, -0.01, -np.ones(2), (0.0, booked["damage"] - 1.0))  # damage booked
+    assert not al.elastic_unloading(pb, -0.01, -np.ones(2), None)  # no cohesive ledger
+
+
 def test_the_path_state_survives_a_checkpoint_whole():
     """Every field of arclength.PathState, set away from its default, comes back from the arrays
     a checkpoint stores (the last load with damage growth and the arc length's recent increments

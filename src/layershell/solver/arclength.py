@@ -758,6 +758,13 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
+            if (ok and st.mode == "arc" and not displacement_path and lam == st.lam_damaged
+                    and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
+                # from a state whose increment damaged, the arc length found the elastic unloading
+                # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
+                # elements, its crack past the load point, went from λ = 0.6078 to 0.6007 so and on
+                # down, 'unloads without damage'): the dissipation constraint next, which demands damage
+                ok, msg = False, "the increment unloads elastically from a debonding state"
             if ok and ledger0 is not None and st.mode == "dissipation":
                 # the constraint takes the stored energy to be the secant one; where the structure
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
@@ -976,6 +983,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.mode, st.size, stretch_accepted = "load", _rescue_increment(ps, lam), 0
         if st.mode == "load":
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
+            if arc and dD is not None and not displacement_path and dD > 1e-9 * max(damage, 1e-300):
+                st.lam_damaged = lam  # a stretch's increment on the debonding branch
         else:
             st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
                            or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
@@ -1192,6 +1201,19 @@ def unloading(lam: float, dlam: float, work_rate: float, lam_damaged: float, lam
     buckling, the load falls while the displacement grows: not unloading.)"""
     return (dlam < 0 and work_rate < 0 and lam_peak > 0 and math.isfinite(lam_damaged)
             and lam < lam_damaged - UNLOADING_FRACTION * lam_peak)
+
+
+def elastic_unloading(problem: Problem, dlam: float, du: np.ndarray, ledger0: tuple[float, float] | None) -> bool:
+    """Does a converged force-path increment (Δλ = ``dlam``, Δu = ``du``) unload without damage?
+    The load and its work-conjugate displacement fall (Δλ < 0, F̂·Δu < 0) while the cohesive
+    interfaces book no damage since ``ledger0`` (:func:`ledger_booked` at the increment's start;
+    None: no cohesive ledger, False). From a state on the debonding branch both branches are
+    equilibria; arc-length control is to follow the one that debonds (:func:`unloading` ends a
+    path that has followed the other far)."""
+    if ledger0 is None or not problem.interfaces.cohesive() or dlam >= 0.0:
+        return False
+    damage = ledger_booked(problem)[1]
+    return float(problem.F_scaled @ du) < 0.0 and not damage - ledger0[1] > 1e-9 * max(damage, 1e-300)
 
 
 def full_weights(problem: Problem) -> np.ndarray:
