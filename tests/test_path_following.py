@@ -946,6 +946,43 @@ def test_an_arc_increment_that_unloads_elastically_from_a_debonding_state_is_ref
     assert not al.elastic_unloading(pb, -0.01, -np.ones(2), None)  # no cohesive ledger
 
 
+def test_an_increment_past_lambda_end_that_load_control_cannot_reach_is_cut(monkeypatch):
+    """An arc-length increment that passes λ_end ends with a load-controlled increment from its
+    start onto λ_end. Where that has no equilibrium (the increment passed a snap-back on its way:
+    the MITC9 plate on 12 × 12 went from 0.982 through the flap's debonding to 1.0245 in one
+    increment, and its path ended there), the increment is cut until it ends below λ_end, from
+    where λ_end is reached; at most END_CUTS times in a run, then the path ends beyond λ_end as
+    before. Stand-ins: arc-length increments that raise λ by 0.3 × Δl (u = λ), load control onto
+    λ_end that converges only from λ ≥ 0.95 (past the snap-back)."""
+    from types import SimpleNamespace
+
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonResult, NewtonSettings
+
+    def attempt(problem, u, lam, size, *a, **k):
+        return al.Attempt(True, np.full(2, lam + 0.3 * size), lam + 0.3 * size, 3, [1e-10])
+
+    def newton_past(problem, u, lam, s):
+        ok = u[0] >= reach
+        return np.full(2, lam), NewtonResult(ok, 5, [1e-10 if ok else 1.0], message="" if ok else "diverged")
+
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, newton=newton_past, full_weights=lambda p: 1.0)
+    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None)
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=6,
+                         jump_area=None, jump_ratio=None, dissipation=False, load_rescue=False)
+    # from 0.9: Δl = 1 (to 1.2) and 0.5 (1.05) pass λ_end where load control cannot reach it, 0.25
+    # ends at 0.975; from there load control reaches λ_end
+    reach = 0.95
+    lams = [st.load_factor for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.9, u0=np.full(2, 0.9))]
+    assert lams == pytest.approx([0.975, 1.0])
+    # where no start reaches it, END_CUTS cuts in all, then the path ends beyond λ_end
+    reach = np.inf
+    lams = [st.load_factor for st in al.path_steps(pb, NewtonSettings(), ps, lam0=0.9, u0=np.full(2, 0.9))]
+    assert lams[-1] > 1.0 and all(x < 1.0 for x in lams[:-1])
+    assert len(lams) <= al.END_CUTS + 1
+
+
 def test_the_path_state_survives_a_checkpoint_whole():
     """Every field of arclength.PathState, set away from its default, comes back from the arrays
     a checkpoint stores (the last load with damage growth and the arc length's recent increments

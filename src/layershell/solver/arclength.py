@@ -694,6 +694,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     # began (its first accepted increment), how many it accepted, and the load factor below
     # which no new one starts (where the last one ended without passing, see stretch_may_start)
     stretch_from, stretch_accepted, stretch_block = lam, 0, -math.inf
+    end_cuts = 0  # increments cut since they passed λ_end where load control could not reach it (END_CUTS)
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
@@ -728,6 +729,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         att = Attempt(True, u_new, end, att.iterations + res.iterations,
                                       att.residuals + res.residuals)
                         to_end = True
+                    elif end_cuts < END_CUTS:
+                        end_cuts += 1
+                        # load control has no equilibrium at λ_end from here: the increment passed a
+                        # snap-back on its way beyond λ_end (the MITC9 plate on 12 × 12: from 0.982
+                        # through the flap's debonding to 1.0245 in one increment). Shorter ones end
+                        # past the snap-back and below λ_end, from where λ_end is reached
+                        att = Attempt(False, att.u, att.lam, att.iterations + res.iterations,
+                                      att.residuals + res.residuals,
+                                      f"the increment passes λ_end = {end:g} (to {att.lam:.6g}), where load "
+                                      f"control from {lam:.6g} finds no equilibrium ({res.message})")
             total_it += att.iterations
             residuals += att.residuals
             ok = att.converged
@@ -1051,6 +1062,13 @@ def _may_rescue(ps: PathSettings, arc: bool, lam: float) -> bool:
     load-controlled increment? ``PathSettings.load_rescue`` (on; not a model-file key), arc-length
     control, a positive load factor (the increment raises it)."""
     return ps.load_rescue and arc and lam > 0.0
+
+
+#: an increment that passes λ_end where load control from its start has no equilibrium at λ_end is
+#: cut, at most this many times in a run (past that, the path ends where the increment does,
+#: beyond λ_end; a bound over the run, since shorter increments that end below λ_end approach
+#: it Zeno-like where no start has load control reach it)
+END_CUTS = 8
 
 
 #: a stretch of load-controlled increments under arc-length control ends at the first increment
