@@ -79,7 +79,8 @@ def mmb_100():
 
 @pytest.mark.slow
 def test_mmb_by_arc_length_follows_beam_theory(mmb_100):
-    """The force-loaded MMB on 100 elements (189 increments, 103 s on 2 cores) by arc length, through the peak along the
+    """The force-loaded MMB on 100 elements (189 increments, 103 s on 2 cores; on 29 Nov 2026
+    214 on one thread, 179 on two: the route past the load point follows round-off) by arc length, through the peak along the
     propagation branch (force control ends at the peak; under displacement control at both load
     points the earlier runs stopped after 3-5 mm of growth):
 
