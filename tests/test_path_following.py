@@ -720,6 +720,21 @@ def _path_stand_ins(monkeypatch, al, **patches) -> None:
     for name, value in {**common, **patches}.items():
         monkeypatch.setattr(al, name, value)
 
+def _stand_in_problem(booked: dict | None = None):
+    """A two-DOF stand-in for the Problem that arclength.path_steps sees (F̂ = (1, 1)); with
+    ``booked`` ({"damage": ...}, the stand-in ledger) cohesive interfaces whose state is that
+    dict (snapshot and restore copy it)."""
+    from types import SimpleNamespace
+
+    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
+                         begin_step=lambda: None)
+    if booked is not None:
+        pb.interfaces = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
+        pb.snapshot, pb.restore = (lambda: dict(booked)), booked.update
+        pb.op = SimpleNamespace(independent=np.arange(2))
+    return pb
+
+
 def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypatch):
     """Where the arc length's increments fail at their smallest size (or crawl), one
     load-controlled increment is tried from the last state (Newton with its own active-set loop);
@@ -728,8 +743,6 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
     λ = 0.5, as past a peak; its cuts cannot reach 0.5 exactly) the run stops with the arc length's message and says that a
     load-controlled increment found no equilibrium either. Stand-ins: constrained iterations that
     never converge, and a Newton solve with equilibria up to λ = 0.5 only."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver.newton import ConvergenceError, NewtonResult, NewtonSettings
 
@@ -741,8 +754,7 @@ def test_a_stuck_arc_length_is_passed_by_one_load_controlled_increment(monkeypat
         return u + 1.0, NewtonResult(ok, 2, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
 
     _path_stand_ins(monkeypatch, al, arc_attempt=never, newton=newton_to_half)
-    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
-                         begin_step=lambda: None)
+    pb = _stand_in_problem()
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, dissipation=False)
     seen = []
@@ -806,8 +818,6 @@ def test_a_rising_branch_on_which_the_arc_length_needs_cuts_is_taken_by_load_con
     the failed increment aimed at.
     Stand-ins: arc-length increments that converge up to Δl = 0.5 (λ + 0.05 each), a Newton
     solve with equilibria up to λ = 0.6."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver.newton import NewtonResult, NewtonSettings
 
@@ -823,8 +833,7 @@ def test_a_rising_branch_on_which_the_arc_length_needs_cuts_is_taken_by_load_con
         return u + 1.0, NewtonResult(ok, 8, [1e-10 if ok else 1e-3], message="" if ok else "diverged")
 
     _path_stand_ins(monkeypatch, al, arc_attempt=arc_to_half, newton=newton_to_06, full_weights=lambda p: 1.0)
-    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
-                         begin_step=lambda: None)
+    pb = _stand_in_problem()
     ps = al.PathSettings(control="arc_length", lambda_end=10.0, increment=0.25, arc_length=1.0, max_cuts=4,
                          jump_area=None, jump_ratio=None, dissipation=False)
     steps = []
@@ -865,8 +874,6 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
     (docs/performance.md). Stand-ins: the dissipation constraint converges with λ falling, the
     arc length with λ rising, a ledger that books nothing (the same increment with damage booked
     is accepted, falling)."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver.newton import NewtonSettings
 
@@ -876,15 +883,12 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
     booked = {"damage": 0.0}
     _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
                     ledger_booked=lambda p: (booked["damage"], booked["damage"]))
-    itf = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
 
     def on_step_end(problem, u, lam):  # commits the state: damage booked where asked
         booked["damage"] += damage_per_increment
         return False
 
-    pb = SimpleNamespace(interfaces=itf, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
-                         begin_step=lambda: None, snapshot=lambda: dict(booked), restore=booked.update,
-                         op=SimpleNamespace(independent=np.arange(2)))
+    pb = _stand_in_problem(booked)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
     for damage_per_increment, expected in ((0.0, 0.51), (1.0, 0.49)):
@@ -908,8 +912,6 @@ def test_an_arc_increment_that_unloads_elastically_from_a_debonding_state_is_ref
     From a state whose increment did not damage (here: none did), the same increment is
     accepted. Stand-ins: the arc length converges with λ and u falling, booking nothing; the
     dissipation constraint with λ rising, booking damage."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver.newton import NewtonSettings
 
@@ -925,10 +927,7 @@ def test_an_arc_increment_that_unloads_elastically_from_a_debonding_state_is_ref
 
     _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
                     ledger_booked=lambda p: (booked["damage"], booked["damage"]))
-    itf = SimpleNamespace(cohesive=lambda: True, dissipation=lambda: [booked["damage"]])
-    pb = SimpleNamespace(interfaces=itf, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
-                         begin_step=lambda: None, snapshot=lambda: dict(booked), restore=booked.update,
-                         op=SimpleNamespace(independent=np.arange(2)))
+    pb = _stand_in_problem(booked)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
     for lam_damaged, expected, modes in ((0.5, 0.51, ["arc", "dissipation"]), (float("nan"), 0.49, ["arc"])):
@@ -954,8 +953,6 @@ def test_an_increment_past_lambda_end_that_load_control_cannot_reach_is_cut(monk
     where λ_end is reached; at most END_CUTS times in a run, then the path ends beyond λ_end as
     before. Stand-ins: arc-length increments that raise λ by 0.3 × Δl (u = λ), load control onto
     λ_end that converges only from λ ≥ 0.95 (past the snap-back)."""
-    from types import SimpleNamespace
-
     from layershell.solver import arclength as al
     from layershell.solver.newton import NewtonResult, NewtonSettings
 
@@ -967,8 +964,7 @@ def test_an_increment_past_lambda_end_that_load_control_cannot_reach_is_cut(monk
         return np.full(2, lam), NewtonResult(ok, 5, [1e-10 if ok else 1.0], message="" if ok else "diverged")
 
     _path_stand_ins(monkeypatch, al, arc_attempt=attempt, newton=newton_past, full_weights=lambda p: 1.0)
-    pb = SimpleNamespace(interfaces=None, dm=SimpleNamespace(n_full=2), F_scaled=np.ones(2), start_inertia=None,
-                         begin_step=lambda: None)
+    pb = _stand_in_problem()
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=6,
                          jump_area=None, jump_ratio=None, dissipation=False, load_rescue=False)
     # from 0.9: Δl = 1 (to 1.2) and 0.5 (1.05) pass λ_end where load control cannot reach it, 0.25

@@ -992,28 +992,27 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         if (st.mode in ("arc", "dissipation") and stretch_may_start(ps, arc, displacement_path, cuts, lam, dlam,
                                                                      peak_before, stretch_block)):
             st.mode, st.size, stretch_accepted = "load", _rescue_increment(ps, lam), 0
+        grew = dD is not None and not displacement_path and beyond_round_off(dD, damage)
+        if grew:
+            st.lam_damaged = lam  # on the debonding branch (a stretch's load-controlled increments too)
         if st.mode == "load":
             st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
-            if arc and dD is not None and not displacement_path and dD > 1e-9 * max(damage, 1e-300):
-                st.lam_damaged = lam  # a stretch's increment on the debonding branch
         else:
             st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
                            or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
                                                st.dissipated, ps.end_fraction))
-            if dD is not None and not displacement_path:
-                if dD > 1e-9 * max(damage, 1e-300):
-                    st.lam_damaged = lam
-                elif not st.finished and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak):
-                    raise ConvergenceError(
-                        f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
-                        f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
-                        f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
-                        f"the branch on which the interfaces debond - past a snap-back its constrained "
-                        f"iterations found no state with damage growth. The states up to here are kept; the "
-                        f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
-                        f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
-                        f"load and reports the energy it releases; or refine the mesh along the debonding front",
-                        lam, residuals[-1] if residuals else float("nan"))
+            if (dD is not None and not displacement_path and not grew and not st.finished
+                    and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak)):
+                raise ConvergenceError(
+                    f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
+                    f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
+                    f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
+                    f"the branch on which the interfaces debond - past a snap-back its constrained "
+                    f"iterations found no state with damage growth. The states up to here are kept; the "
+                    f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
+                    f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
+                    f"load and reports the energy it releases; or refine the mesh along the debonding front",
+                    lam, residuals[-1] if residuals else float("nan"))
         recent = (recent + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
         recent_dG = (recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
         crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
@@ -1198,7 +1197,7 @@ def complete_failure(lam: float, dlam: float, lam_peak: float, dG: float, dissip
     (ΔG at round-off), which can take λ to 0 as well - the DCB on 100 elements, half its
     interface debonded, unloaded along its secant and was reported as failed."""
     return (lam_peak > 0 and dlam < 0 and lam <= end_fraction * lam_peak
-            and dG > 1e-9 * max(dissipated, 1e-300))
+            and beyond_round_off(dG, dissipated))
 
 
 #: a force path by arc length whose load factor fell by this share of its peak since the last
@@ -1231,7 +1230,13 @@ def elastic_unloading(problem: Problem, dlam: float, du: np.ndarray, ledger0: tu
     if ledger0 is None or not problem.interfaces.cohesive() or dlam >= 0.0:
         return False
     damage = ledger_booked(problem)[1]
-    return float(problem.F_scaled @ du) < 0.0 and not damage - ledger0[1] > 1e-9 * max(damage, 1e-300)
+    return float(problem.F_scaled @ du) < 0.0 and not beyond_round_off(damage - ledger0[1], damage)
+
+
+def beyond_round_off(booked: float, total: float) -> bool:
+    """Did an increment book ``booked`` (dissipated or damage energy) beyond round-off of the
+    ``total`` booked so far?"""
+    return booked > 1e-9 * max(total, 1e-300)
 
 
 def full_weights(problem: Problem) -> np.ndarray:
