@@ -593,7 +593,9 @@ class InterfaceDef(Strict):
     alpha_N: PositiveFloat | None = Field(None, description=(
         "normal contact penalty (force/length³; default 100 E3/H_min)"))
     alpha_T: PositiveFloat | None = Field(
-        None, description="tangential stick penalty of the regularised friction (default G13/H of the thinner layer)")
+        None, description="tangential stick penalty of the regularised friction (default G13/H of the thinner layer; "
+                          "with the cohesive law K0: where its friction stalls Newton at a peak, G13/H passes it, "
+                          "docs/performance.md)")
     open_gap: PositiveFloat | None = Field(
         None, description="a debonded point whose gap exceeds this is open: no friction there (default 0.1 × the "
                           "upper layer's thickness; an addition, the thesis's friction stops at any opening)")
