@@ -720,6 +720,7 @@ def _path_stand_ins(monkeypatch, al, **patches) -> None:
     for name, value in {**common, **patches}.items():
         monkeypatch.setattr(al, name, value)
 
+
 def _stand_in_problem(booked: dict | None = None):
     """A two-DOF stand-in for the Problem that arclength.path_steps sees (F̂ = (1, 1)); with
     ``booked`` ({"damage": ...}, the stand-in ledger) cohesive interfaces whose state is that
