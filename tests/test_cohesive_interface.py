@@ -137,9 +137,14 @@ def test_block_tangent_against_finite_differences(rule, friction, viscosity):
     from helpers import fd_reduced_tangent
 
     pb, blk, ur = _damaged_problem(rule, f"viscosity = {viscosity}")
-    if friction:  # slip limits on the damaged share, some points sticking, some sliding
+    if friction:  # slip limits on the damaged share, some points sticking, some sliding, with the
+        # stick penalty per point (cohesive.stick_penalty)
+        from layershell.cohesive import stick_penalty
+
         rng = np.random.default_rng(5)
         blk.contact.cap = rng.uniform(0.0, 0.05, blk.d_old.shape)
+        blk.contact.alpha_T = stick_penalty(blk.K, blk.contact.cap, blk.law.tau_max)
+        assert np.ptp(blk.contact.alpha_T) > 0
         blk.contact.g_p = rng.normal(size=blk.contact.g_p.shape) * 1e-6
     delta = blk.separation(pb.op.T @ ur)
     _, _, d, _ = blk.point_state(pb.op.T @ ur)
@@ -633,23 +638,52 @@ def test_adaptive_load_steps_stabilise_a_step_without_equilibrium(monkeypatch):
     assert lams == [0.25, 0.5] and "past load factor 0.5 the rate-independent path has no equilibrium" in err
 
 
-def test_friction_stick_penalty_of_the_cohesive_law_only_regularises():
-    """The friction on the damaged share of a cohesive interface sticks with the penalty α_T =
-    K0 = 50 E3/H by default (1.7·10¹¹ for the §5.1 plate's TRC layer, from the example's
-    numbers); G13/H of the thinner layer (1.453·10⁹, the thesis law's default) is the setting
-    that passes the cohesive slab's end-debonding peak on 16 × 12 by arc length, where K0's stick
-    ranges of 10⁻¹¹-10⁻¹⁰ m made the friction rigid-plastic and Newton stalled
-    (docs/performance.md). The penalty only regularises: the plate with friction on 6 × 6 to
-    λ = 1 (friction dissipating) gives the same w_front_max and friction dissipation with either
-    (measured: equal to 10⁻¹¹)."""
+def test_friction_stick_penalty_per_point_and_its_checkpoint():
+    """The friction on the damaged share of a cohesive interface sticks with α_T min(1, cap/τ_max)
+    per point (cohesive.stick_penalty; α_T = K0 = 50 E3/H by default, 1.7·10¹¹ for the §5.1
+    plate's TRC layer, from the example's numbers), so every point sticks elastically over at
+    least τ_max/α_T of slip whatever its slip limit: with K0 throughout, the points of low
+    pressure stuck over 10⁻¹¹-10⁻¹⁰ m only (rigid-plastic) and the cohesive slab stalled at its
+    end-debonding peak (docs/performance.md). Checked on the 6 × 6 plate at λ = 1, where friction
+    acts: the penalty of every point with a slip limit, and a snapshot restored (as a checkpoint
+    is) gives the same penalties."""
+    from layershell.cohesive import stick_penalty
+    from layershell.solver import newton as nw
+
     spec = example_spec("cantilever_plate_cohesive")
     pb = Problem.build(spec.model)
     (blk,) = [b for b in pb.assembler.extra if hasattr(b, "contact")]
-    assert blk.K == pytest.approx(50 * 3.4e7 / 0.01, rel=1e-12)
-    assert blk.contact.alpha_T == blk.K
-    stiff = run_example("cantilever_plate_cohesive").summary  # 6 × 6
-    soft = run_example("cantilever_plate_cohesive", {"mu0 = 0.95 ": "alpha_T = 1.453e9\nmu0 = 0.95 "}).summary
-    assert soft["converged"] and stiff["converged"]
-    assert soft["energy"]["dissipated_friction"] > 1e-3 * soft["energy"]["dissipated_fracture"]  # friction acts
-    assert soft["probes"]["w_front_max"] == pytest.approx(stiff["probes"]["w_front_max"], rel=1e-6)
-    assert soft["energy"]["dissipated_friction"] == pytest.approx(stiff["energy"]["dissipated_friction"], rel=1e-6)
+    K, tau = blk.K, blk.law.tau_max
+    assert K == pytest.approx(50 * 3.4e7 / 0.01, rel=1e-12) and tau == 1210.0
+    ctl = pb.interfaces
+    *_, last = nw.load_steps(pb, spec.load_factors, spec.newton, on_step_end=lambda p, u, lam: ctl.update(p, u, lam))
+    assert last.load_factor == 1.0
+    cb = blk.contact
+    on = cb.cap > 0
+    assert on.sum() >= 5 and np.any(cb.cap[on] < 0.5 * tau)  # friction acts (10 points), some below τ_max
+    np.testing.assert_allclose(cb.alpha_T[on], K * np.minimum(cb.cap[on] / tau, 1.0), rtol=1e-14)
+    np.testing.assert_array_equal(cb.alpha_T[~on], K)
+    assert stick_penalty(2.0, np.array([0.0, 0.5, 1.0, 3.0]), 2.0).tolist() == [2.0, 0.5, 1.0, 2.0]
+    # the stick range cap/α_T of every point with friction is at least τ_max/K0
+    assert np.all(cb.cap[on] / cb.alpha_T[on] >= tau / K * (1 - 1e-12))
+    snap = pb.snapshot()
+    alpha = cb.alpha_T.copy()
+    cb.alpha_T = K
+    pb.restore(snap)
+    np.testing.assert_array_equal(blk.contact.alpha_T, alpha)
+
+
+def test_friction_stick_penalty_of_the_cohesive_law_only_regularises():
+    """The stick penalty only regularises: the plate with friction on 6 × 6 to λ = 1 (friction
+    dissipating) gives the same w_front_max and friction dissipation with the default α_T = K0,
+    with G13/H of the thinner layer (1.453·10⁹, the thesis law's default: stick ranges 117 ×
+    longer) and with 100 K0 (100 × shorter); measured: w_front_max equal to 3·10⁻¹¹, the friction
+    dissipation to 4·10⁻⁷ (G13/H) and 4·10⁻⁹ (100 K0)."""
+    runs = {a: run_example("cantilever_plate_cohesive", {"mu0 = 0.95 ": f"alpha_T = {a}\nmu0 = 0.95 "} if a else {})
+            .summary for a in (None, "1.453e9", "1.7e13")}
+    ref = runs[None]
+    assert ref["energy"]["dissipated_friction"] > 1e-3 * ref["energy"]["dissipated_fracture"]  # friction acts
+    for other in runs.values():
+        assert other["converged"]
+        assert other["probes"]["w_front_max"] == pytest.approx(ref["probes"]["w_front_max"], rel=1e-8)
+        assert other["energy"]["dissipated_friction"] == pytest.approx(ref["energy"]["dissipated_friction"], rel=1e-5)

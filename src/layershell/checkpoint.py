@@ -36,7 +36,9 @@ import numpy as np
 from .io.output import atomic_write
 
 # 2: the cohesive interfaces' fracture energy per point (CohesiveRun.fracture), 27 Nov 2026
-FORMAT_VERSION = 2
+# 3: the stick anchors of a cohesive interface's friction belong to a stick penalty per point
+#    (cohesive.stick_penalty), 29 Nov 2026
+FORMAT_VERSION = 3
 FILENAME = "checkpoint.npz"
 
 

@@ -44,7 +44,8 @@ class CohesiveLaw:
     viscosity: Gao & Bower (2004) regularisation time in load-factor units (0: off);
     mu0, mu, gT_mu, mu_coulomb: the thesis's adhesive slip-softening friction (4.70)-(4.84),
     which acts on the damaged share of a point under compression; alpha_T: its stick penalty
-    (None: K0); rule: "lobatto" (nodal, default) or "gauss" integration of the interface.
+    (None: K0), reduced per point where the slip limit is below tau_max (:func:`stick_penalty`);
+    rule: "lobatto" (nodal, default) or "gauss" integration of the interface.
     """
 
     G_Ic: float
@@ -105,6 +106,25 @@ class CohesiveLaw:
         the process zone in a thick body. Slender layers have other lengths (mode I much shorter
         in a DCB): the process-zone warning uses :mod:`layershell.process_zone`."""
         return E * min(self.G_Ic / self.sigma_max**2, self.G_IIc / self.tau_max**2)
+
+
+# ---------------------------------------------------------------------- friction
+def stick_penalty(alpha_T: float, cap: np.ndarray, tau_max: float) -> np.ndarray:
+    """Stick penalty (e, q) of the friction on the damaged share: α_T min(1, cap/τ_max) at a point
+    with the slip limit ``cap`` > 0 (α_T where there is no friction).
+
+    With one α_T for all points a point sticks only while its slip from the anchor stays below
+    cap/α_T, which vanishes with the contact pressure: with α_T = K0 = 50 E3/H the points of low
+    pressure at the TRC slab's end-debonding peak stuck over 10⁻¹¹-10⁻¹⁰ m (rigid-plastic
+    friction), and where their slip had to reverse the return mapping threw their friction force
+    from +cap to -cap between Newton iterates, so the residual stalled (docs/performance.md).
+    Scaled so, every point sticks elastically over at least τ_max/α_T - with the default α_T =
+    K0 the slip at which the intact bond reaches its shear strength - a fixed elastic slip rather
+    than a fixed stiffness, as in the penalty friction of commercial codes (Abaqus's maximum
+    elastic slip). It only regularises: the answer does not depend on it where friction acts
+    (tests/test_cohesive_interface.py)."""
+    ratio = np.minimum(np.asarray(cap, float) / tau_max, 1.0)
+    return alpha_T * np.where(ratio > 0.0, ratio, 1.0)
 
 
 # ---------------------------------------------------------------------- onset

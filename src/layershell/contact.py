@@ -95,7 +95,7 @@ class ContactBlock:
     # traction scale of set violations (the interface's tensile strength σ_max; None: not measured)
     strength: float | None = None
     # penalty-regularised friction (return mapping): None = friction only as external loads
-    alpha_T: float | None = None
+    alpha_T: float | np.ndarray | None = None  # a number, or one per point (e, q) (cohesive.stick_penalty)
     cap: np.ndarray | None = None  # (e, q) slip limit of the current step (0: no friction)
     t_n: np.ndarray | None = None  # (e, q, 3) converged tangential traction (upper on lower)
     g_p: np.ndarray | None = None  # (e, q, 3) slip anchor: t = α_T (P Δu - g_p) while sticking
@@ -224,11 +224,14 @@ class ContactBlock:
         addition to the thesis, which applies friction as loads). Returns t (e, q, 3) (force of
         the upper layer on the lower one per area) and its consistent tangent dt/dΔu (e, q, 3, 3):
         α_T P sticking, α_T cap/|t_tr| (I - e⊗e) P sliding (symmetric: e lies in the tangent
-        plane). ``du``: the relative displacement at ``u_full`` if already known."""
+        plane). α_T is a number or one per point (e, q). ``du``: the relative displacement at
+        ``u_full`` if already known."""
         P = self.projector()
         du = self.relative_displacement(u_full) if du is None else du
         gT = np.einsum("eqij,eqj->eqi", P, du)
-        t_tr = self.alpha_T * (gT - self.g_p)
+        aT = np.asarray(self.alpha_T, float)
+        aT = aT[..., None] if aT.ndim else aT  # one per point: (e, q, 1)
+        t_tr = aT * (gT - self.g_p)
         n = np.linalg.norm(t_tr, axis=-1)
         on = self.released & (self.cap > 0)
         cap = np.where(on, self.cap, 1.0)
@@ -237,7 +240,7 @@ class ContactBlock:
         e = t_tr / np.where(n > 0, n, 1.0)[..., None]
         ee = np.einsum("eqi,eqj->eqij", e, e)
         dtdtr = f_over_x[..., None, None] * (np.eye(3) - ee) + fprime[..., None, None] * ee
-        D = self.alpha_T * np.einsum("eqij,eqjk->eqik", dtdtr, P) * on[..., None, None]
+        D = aT[..., None] * np.einsum("eqij,eqjk->eqik", dtdtr, P) * on[..., None, None]
         return t_tr * (f_over_x * on)[..., None], D
 
     def response(self, u_full: np.ndarray, tangent: bool = True, compact: bool = False, points: bool = False):

@@ -593,9 +593,11 @@ class InterfaceDef(Strict):
     alpha_N: PositiveFloat | None = Field(None, description=(
         "normal contact penalty (force/length³; default 100 E3/H_min)"))
     alpha_T: PositiveFloat | None = Field(
-        None, description="tangential stick penalty of the regularised friction (default G13/H of the thinner layer; "
-                          "with the cohesive law K0: where its friction stalls Newton at a peak, G13/H passes it, "
-                          "docs/performance.md)")
+        None, description="tangential stick penalty of the regularised friction (stress/length). Thesis law: "
+                          "default G13/H of the thinner layer. Cohesive law: default K0, and at a point whose slip "
+                          "limit is below tau_max scaled by limit/tau_max, so that every point sticks over a slip "
+                          "of at least tau_max/alpha_T (a fixed penalty made low-pressure points rigid-plastic and "
+                          "stalled Newton at peaks, docs/performance.md)")
     open_gap: PositiveFloat | None = Field(
         None, description="a debonded point whose gap exceeds this is open: no friction there (default 0.1 × the "
                           "upper layer's thickness; an addition, the thesis's friction stops at any opening)")

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, fields, replace
 import numpy as np
 
 from ..cohesive import (FULL_DAMAGE, CohesiveBlock, CohesiveLaw, cohesive_traction_energy, path_dissipation,
-                        separation_measures)
+                        separation_measures, stick_penalty)
 from ..contact import ContactBlock, friction_shape_inverse
 from ..delamination import InterfaceLaw, failure_function, return_map_at_fracture, tau_delam, tau_slide
 from ..interfaces import Interface, interface_state, interfaces
@@ -134,9 +134,16 @@ class CohesiveRun:
         x = np.clip(tn / np.where(newcap > 0, newcap, 1.0), 0.0, 0.999)
         e = tconv / np.where(tn > 0, tn, 1.0)[..., None]
         gTu = np.einsum("eqij,eqj->eqi", P, delta)
-        cb.g_p = np.where((newcap > 0)[..., None], gTu - (x * newcap)[..., None] * e / cb.alpha_T, gTu)
+        cb.alpha_T = stick_penalty(self.stick_base, newcap, law.tau_max)
+        cb.g_p = np.where((newcap > 0)[..., None], gTu - (x * newcap)[..., None] * e / cb.alpha_T[..., None], gTu)
         cb.cap = newcap
         cb.t_n = tconv
+
+    @property
+    def stick_base(self) -> float:
+        """α_T of the friction on the damaged share before the per-point reduction
+        (:func:`~layershell.cohesive.stick_penalty`): the law's, or the cohesive penalty K."""
+        return self.law.alpha_T if self.law.alpha_T is not None else self.block.K
 
 
 @dataclass
@@ -498,6 +505,7 @@ class InterfaceController:
                 r.block.d_old = take(f"run{i}.block.d_old", r.block.d_old)
                 r.block.dv_old = take(f"run{i}.block.dv_old", r.block.dv_old)
                 r.block.lam_old = float(take(f"run{i}.block.lam_old", None))
+                r.block.contact.alpha_T = stick_penalty(r.stick_base, r.block.contact.cap, r.law.tau_max)
                 if f"run{i}.viscosity" in state:  # automatic stabilisation (stabilize) switched it on or off
                     r.law = replace(r.law, viscosity=float(state[f"run{i}.viscosity"]))
                     r.block.law = r.law
@@ -700,8 +708,8 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
     cb = ContactBlock.build(model, dm, itf, K, rule=law.rule)
     ne, nq = cb.w.shape
     cb.released = np.ones((ne, nq), bool)
-    cb.alpha_T = law.alpha_T if law.alpha_T is not None else K
     cb.cap, cb.t_n, cb.g_p = np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3))
+    cb.alpha_T = stick_penalty(law.alpha_T if law.alpha_T is not None else K, cb.cap, law.tau_max)
     problem.bonded[itf.upper] = np.zeros_like(problem.bonded[itf.upper])
     d0 = np.zeros((ne, nq))
     if initial_nodes is not None:
