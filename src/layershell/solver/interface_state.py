@@ -134,16 +134,18 @@ class CohesiveRun:
         x = np.clip(tn / np.where(newcap > 0, newcap, 1.0), 0.0, 0.999)
         e = tconv / np.where(tn > 0, tn, 1.0)[..., None]
         gTu = np.einsum("eqij,eqj->eqi", P, delta)
-        cb.alpha_T = stick_penalty(self.stick_base, newcap, law.tau_max)
-        cb.g_p = np.where((newcap > 0)[..., None], gTu - (x * newcap)[..., None] * e / cb.alpha_T[..., None], gTu)
         cb.cap = newcap
+        self.set_stick_penalty()
+        cb.g_p = np.where((newcap > 0)[..., None], gTu - (x * newcap)[..., None] * e / cb.alpha_T[..., None], gTu)
         cb.t_n = tconv
 
-    @property
-    def stick_base(self) -> float:
-        """α_T of the friction on the damaged share before the per-point reduction
-        (:func:`~layershell.cohesive.stick_penalty`): the law's, or the cohesive penalty K."""
-        return self.law.alpha_T if self.law.alpha_T is not None else self.block.K
+    def set_stick_penalty(self) -> None:
+        """The friction's stick penalty per point from the block's slip limits
+        (:func:`~layershell.cohesive.stick_penalty`; α_T the law's, or the cohesive penalty K):
+        at construction, at each commit and after a restore."""
+        cb = self.block.contact
+        base = self.law.alpha_T if self.law.alpha_T is not None else self.block.K
+        cb.alpha_T = stick_penalty(base, cb.cap, self.law.tau_max)
 
 
 @dataclass
@@ -505,7 +507,7 @@ class InterfaceController:
                 r.block.d_old = take(f"run{i}.block.d_old", r.block.d_old)
                 r.block.dv_old = take(f"run{i}.block.dv_old", r.block.dv_old)
                 r.block.lam_old = float(take(f"run{i}.block.lam_old", None))
-                r.block.contact.alpha_T = stick_penalty(r.stick_base, r.block.contact.cap, r.law.tau_max)
+                r.set_stick_penalty()
                 if f"run{i}.viscosity" in state:  # automatic stabilisation (stabilize) switched it on or off
                     r.law = replace(r.law, viscosity=float(state[f"run{i}.viscosity"]))
                     r.block.law = r.law
@@ -709,7 +711,6 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
     ne, nq = cb.w.shape
     cb.released = np.ones((ne, nq), bool)
     cb.cap, cb.t_n, cb.g_p = np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3))
-    cb.alpha_T = stick_penalty(law.alpha_T if law.alpha_T is not None else K, cb.cap, law.tau_max)
     problem.bonded[itf.upper] = np.zeros_like(problem.bonded[itf.upper])
     d0 = np.zeros((ne, nq))
     if initial_nodes is not None:
@@ -717,8 +718,10 @@ def _cohesive_run(problem, itf: Interface, law: CohesiveLaw, initial_nodes) -> C
         init[initial_nodes] = True
         d0 = np.where(init[cb.conn[:, cb.region]], 1.0, 0.0)
     blk = CohesiveBlock(cb, law, K, d0, dv_old=d0.copy())
-    return CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
-                       np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
+    run = CohesiveRun(blk, law, np.zeros((ne, nq)), np.zeros((ne, nq, 3)), np.zeros((ne, nq, 3)), np.zeros(3),
+                      np.array(np.nan), d0 > 0, np.zeros((ne, nq)))
+    run.set_stick_penalty()
+    return run
 
 
 def _arm(model, k: int, direction: np.ndarray, normal: np.ndarray) -> Arm:
