@@ -687,3 +687,82 @@ def test_friction_stick_penalty_of_the_cohesive_law_only_regularises():
         assert other["converged"]
         assert other["probes"]["w_front_max"] == pytest.approx(ref["probes"]["w_front_max"], rel=1e-8)
         assert other["energy"]["dissipated_friction"] == pytest.approx(ref["energy"]["dissipated_friction"], rel=1e-5)
+
+
+def _plate_with_friction_at_full_load():
+    """The §5.1 cohesive plate (6 × 6) at λ = 1, where friction acts on the damaged share."""
+    from layershell.solver import newton as nw
+
+    spec = example_spec("cantilever_plate_cohesive")
+    pb = Problem.build(spec.model)
+    (blk,) = [b for b in pb.assembler.extra if hasattr(b, "contact")]
+    ctl = pb.interfaces
+    *_, last = nw.load_steps(pb, spec.load_factors, spec.newton, on_step_end=lambda p, u, lam: ctl.update(p, u, lam))
+    assert last.load_factor == 1.0 and np.any(blk.contact.cap > 0)
+    return pb, blk, last.u
+
+
+def test_friction_stick_state_is_frozen_with_the_cohesive_sets():
+    """The cohesive active-set loop freezes the friction's stick state with the tension and
+    loading sets (CohesiveBlock.freeze): a point frozen sticking keeps the stick law beyond its slip
+    limit, so that a frozen solve is smooth where points start at their limit (every point that
+    slid in the last increment does); the set check reports the excess d (|t_tr| - cap) in units
+    of τ_max, and unfreezing gives back the return mapping (the traction capped at the limit).
+    Checked on a point of the 6 × 6 plate at λ = 1 whose anchor is moved to twice its limit."""
+    pb, blk, u = _plate_with_friction_at_full_load()
+    cb = blk.contact
+    blk.freeze(u)
+    x = cb.slip_ratio(u)
+    np.testing.assert_array_equal(cb.stick_frozen, x < 1.0)
+    assert blk.set_violation(u) == 0.0 or blk.set_violation(u) <= blk.CONSISTENCY_TOL  # the converged state
+    e, q = np.argwhere((cb.cap > 0) & cb.stick_frozen & (blk.d_old > 0))[0]
+    t_tr = cb.trial_traction(u)[e, q]
+    # move the anchor so that the trial traction is twice the slip limit, along the same direction
+    n = t_tr / np.linalg.norm(t_tr) if np.linalg.norm(t_tr) > 0 else np.cross(cb.A3[e, q], [0.0, 0.0, 1.0] if abs(cb.A3[e, q, 2]) < 0.9 else [1.0, 0.0, 0.0])
+    n = n / np.linalg.norm(n)
+    aT = np.asarray(cb.alpha_T, float)[e, q]
+    cb.g_p[e, q] += (t_tr - 2.0 * cb.cap[e, q] * n) / aT
+    t, D = cb.friction_traction(u)
+    np.testing.assert_allclose(t[e, q], 2.0 * cb.cap[e, q] * n, rtol=1e-9, atol=1e-12 * cb.cap[e, q])
+    P = np.eye(3) - np.outer(cb.A3[e, q], cb.A3[e, q])
+    np.testing.assert_allclose(D[e, q], aT * P, rtol=1e-12)  # the stick tangent
+    d = blk.d_old[e, q]
+    assert blk.set_violation(u) >= cb.cap[e, q] * d / blk.law.tau_max * (1 - 1e-9)
+    blk.unfreeze()
+    assert cb.stick_frozen is None
+    t, _ = cb.friction_traction(u)
+    np.testing.assert_allclose(t[e, q], cb.cap[e, q] * n, rtol=1e-9, atol=1e-12 * cb.cap[e, q])
+
+
+def test_reversal_step_stops_a_sliding_point_at_its_anchor():
+    """A sliding point has no stiffness along its slip, so a Newton correction can carry it through
+    its stick range at once and throw its friction from +cap to -cap (the TRC slab stalled so on
+    its snap-back). CohesiveBlock.reversal_step gives the fraction of a correction that takes no
+    sliding point past its anchor, and arclength.reversal_step takes at least REVERSAL_STEP_MIN of it.
+    Checked on one point of the 6 × 6 plate at λ = 1 made to slide at three times its limit, with
+    the correction -c u chosen so that the whole of it reverses the point's trial traction to -3 cap:
+    the fraction is 1/2, and there the trial traction is at the anchor."""
+    from layershell.solver import arclength as al
+
+    pb, blk, u = _plate_with_friction_at_full_load()
+    cb = blk.contact
+    v = cb.trial_traction(u, anchored=False)
+    on = (cb.cap > 0) & (np.linalg.norm(v, axis=-1) > 0)
+    e, q = np.argwhere(on)[0]
+    cap = cb.cap.copy()
+    cb.cap = np.where(np.arange(cap.size).reshape(cap.shape) == e * cap.shape[1] + q, cap, 0.0)  # this point only
+    vn = np.linalg.norm(v[e, q])
+    vhat = v[e, q] / vn
+    aT = np.asarray(cb.alpha_T, float)[e, q]
+    s = 3.0 * cb.cap[e, q]
+    cb.g_p[e, q] = (v[e, q] - s * vhat) / aT  # t_tr = s vhat: sliding
+    assert cb.slip_ratio(u)[e, q] == pytest.approx(3.0)
+    c = 2.0 * s / vn  # the correction -c u changes t_tr by -c v = -2 s vhat
+    eta = blk.reversal_step(u, -c * u)
+    assert eta == pytest.approx(0.5, rel=1e-9)
+    np.testing.assert_allclose(cb.trial_traction(u + eta * (-c * u))[e, q] @ vhat, 0.0, atol=1e-9 * s)
+    assert blk.reversal_step(u, 0.25 * c * u) == 1.0  # further along the slip: no limit
+    assert blk.reversal_step(u, -0.4 * c * u) == 1.0  # back into the stick range only: no limit
+    assert al.reversal_step(pb, u, -1e3 * c * u) == al.REVERSAL_STEP_MIN
+    cb.cap = np.zeros_like(cap)
+    assert blk.reversal_step(u, -c * u) == 1.0  # no friction: no limit

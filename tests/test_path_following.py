@@ -712,11 +712,12 @@ def test_load_column_of_prescribed_displacements_is_the_tangent_times_g(nonlinea
 
 def _path_stand_ins(monkeypatch, al, **patches) -> None:
     """Stand-ins for the problem-side helpers of arclength.path_steps (no interfaces, no
-    prescribed displacements, nothing dissipated), plus ``patches`` (name: stand-in)."""
+    prescribed displacements, nothing dissipated, no active-set blocks), plus ``patches``
+    (name: stand-in)."""
     common = {"check_path": lambda p, ps: None, "interface_form": lambda p: False,
               "prescribed_direction": lambda p: None, "dissipation_so_far": lambda p: 0.0,
               "dissipation_increment": lambda *a: 0.0, "conjugates": lambda p, u: (0.0, 0.0),
-              "check_stabilised_step": lambda *a: None}
+              "check_stabilised_step": lambda *a: None, "active_set_blocks": lambda p: ([], False)}
     for name, value in {**common, **patches}.items():
         monkeypatch.setattr(al, name, value)
 
@@ -901,6 +902,54 @@ def test_a_dissipation_increment_met_by_friction_while_the_load_falls_is_refused
         # the step's path state (what a checkpoint keeps) carries the last load with damage growth
         assert steps[0].state.lam_damaged == pytest.approx(0.49) if damage_per_increment else np.isnan(
             steps[0].state.lam_damaged)
+
+
+def test_a_dissipation_increment_too_short_to_damage_is_grown_where_friction_acts(monkeypatch):
+    """Where friction acts on a cohesive interface, a dissipation-controlled increment refused as
+    friction's (FRICTION_REFUSED: λ falls, the ledger books less than half of Δτ as damage) may be
+    too short to damage: the constraint, which takes unloading to be secant, is then met by the
+    energy that the stick springs and the contact give back (the TRC slab on 16 × 12 crawled so on
+    its snap-back at 305.90 kN/m²: Δτ = 10⁻¹¹-10⁻⁷ booked 2·10⁻¹¹-4·10⁻¹⁰, while 10⁻⁶-10⁻³ booked
+    81-100 %). It is grown GROW_FACTOR times, at most GROW_REFUSED times, before it is cut; without
+    friction, or where growing does not help, the refusal goes on as before (cut, then the arc
+    length, which here rises). Stand-ins: the dissipation constraint converges with λ falling, the
+    arc length with λ rising, a ledger that books an increment's Δτ as damage from ``least`` on."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonSettings
+
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        tried.append((mode, size))
+        return al.Attempt(True, u + 1e-3, lam - 0.01 if mode == "dissipation" else lam + 0.01, 3, [1e-10])
+
+    booked = {"damage": 0.0}
+    acts = {"friction": True}
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]),
+                    active_set_blocks=lambda p: ([], True), friction_acts=lambda blocks: acts["friction"])
+
+    def on_step_end(problem, u, lam):  # commits the state: Δτ booked as damage from ``least`` on
+        mode, size = tried[-1]
+        booked["damage"] += size if mode == "dissipation" and size >= least else 1e-12
+        return False
+
+    pb = _stand_in_problem(booked)
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
+    for friction, least, expected, grown in ((True, 1e-3, 0.49, 3), (False, 1e-3, 0.51, 0),
+                                             (True, 1e3, 0.51, al.GROW_REFUSED)):
+        booked["damage"], acts["friction"], tried[:] = 0.0, friction, []
+        st0 = al.PathState(mode="dissipation", size=1e-5, arc_length=1.0, lam_peak=0.5, arc_length0=1.0)
+        steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                                   on_step_end=on_step_end))
+        assert [s.load_factor for s in steps] == pytest.approx([expected])
+        sizes = [size for mode, size in tried if mode == "dissipation"]
+        assert sizes[:grown + 1] == pytest.approx([1e-5 * al.GROW_FACTOR**k for k in range(grown + 1)])
+        if expected < 0.5:  # accepted after growing
+            assert len(sizes) == grown + 1 and tried[-1][0] == "dissipation"
+        else:  # not grown further: cut from the refused size (1e-5), then the arc length
+            assert all(size <= 1e-5 for size in sizes[grown + 1:]) and tried[-1][0] == "arc"
 
 
 def test_an_arc_increment_that_unloads_elastically_from_a_debonding_state_is_refused(monkeypatch):

@@ -200,9 +200,16 @@ def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
     the peak), the path passes the peak and the dissipation constraint traces the snap-back:
     measured on one and on two threads, from 327.12 down to 306.68 kN/m² (103 increments,
     balance 2.8e-4), where it stops just as the first point debonds fully (the same state as on
-    16 × 12 and 24 × 18, docs/performance.md). Asserted: below 95 % of the peak on the falling
-    branch, with the interface still intact (before, the run stopped at 326.97 in some runs;
-    in others, e.g. 81cba8c here, it went down to 278.1 and up to 295.1)."""
+    16 × 12 and 24 × 18, docs/performance.md). There about 30 sliding friction points reversed
+    together between iterates; with the friction's stick state frozen in the active-set loop,
+    the corrections limited so that no sliding point passes its anchor (arclength.reversal_step)
+    and dissipation increments that are too short to damage grown instead of cut
+    (arclength.FRICTION_REFUSED), the path goes on down to 288.16 kN/m² (306 increments, 383 s,
+    balance 2.8e-4; the first point fully debonded at 305.76) and stops at 290.55 where the
+    loading set of the process zone keeps changing. Without the growth it stopped at 308.89.
+    Asserted: below 90 % of the peak on the falling branch, with the interface still intact
+    (before, the run stopped at 326.97 in some runs, at 306.68 in others, and 81cba8c here went
+    down to 278.1 and up to 295.1)."""
     r = _cohesive_slab({"n = 20\n": 'n = 80\ncontrol = "arc_length"\nmax_steps = 3000\n',
                         "lambda_end = 100.0": "lambda_end = 400.0"})
     s = r.summary
@@ -218,7 +225,7 @@ def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
     assert max(lam[i] for i in intact) == pytest.approx(327.13, rel=2e-3)
     assert max(balance[i] for i in intact) < 0.01
     top = max(intact, key=lambda i: lam[i])
-    assert min(lam[i] for i in intact if i > top) < 0.95 * lam[top]  # down the snap-back
+    assert min(lam[i] for i in intact if i > top) < 0.9 * lam[top]  # down the snap-back
     rescued = {int(m) for w in s["warnings"]
                for m in re.findall(r"step (\d+): the arc length could not go on", w)}
     # the steps solved by load control (a step's "constraint" is that of the next one)

@@ -464,7 +464,9 @@ class CohesiveBlock:
         stiffness drops from K to the softening slope, and the normal stiffness of a damaged
         point at δ_n = 0 - are then handled by the active-set loop (:func:`~layershell.solver.
         newton.newton`): semi-smooth Newton across the onset kink can cycle between the states
-        of a few points at the crack tip (DCB, issue 13).
+        of a few points at the crack tip (DCB, issue 13). Where friction acts on the damaged
+        share, its stick state is frozen too (``contact.stick_frozen``: a point frozen sticking
+        keeps the stick law beyond its slip limit; :meth:`set_violation` checks it).
 
         ``limited``: change the frozen loading set only at the points that violate it most
         (those within 1e-6 of the largest |d_trial - d_old| among the points whose state
@@ -482,6 +484,12 @@ class CohesiveBlock:
             if worst > 0.0:
                 loading = np.where(viol >= (1.0 - 1e-6) * worst, loading, prev)
         self.frozen = (tension, loading)
+        cb = self.contact
+        if cb.cap is not None and np.any(cb.cap > 0):
+            # the friction's stick state too: within the frozen solve a sticking point keeps the
+            # stick law, so that points that start at their limit (the committed sliding state)
+            # do not switch between stick and slip from one iterate to the next
+            cb.stick_frozen = cb.slip_ratio(u_full) < 1.0
 
     def release_closed(self, u_full: np.ndarray) -> int:
         """Take the points frozen as opening and loading whose normal separation is negative at
@@ -524,7 +532,8 @@ class CohesiveBlock:
         largest traction change, as a fraction of the point's strength K λ0(B), that taking the
         actual sets would make at one point - K λ |d_trial - d_held| for a loading point whose
         damage fell below its history or a point outside the set whose trial damage exceeds it,
-        K d |δ_n| for a damaged point whose tension state changed; 0 where the sets hold
+        K d |δ_n| for a damaged point whose tension state changed, d (|t_tr| - cap) for a point
+        frozen sticking beyond its friction limit (:meth:`_friction_violation`); 0 where the sets hold
         (:data:`LOADING_TOL` on the damage). The active-set loop accepts a cycling set whose
         violation is below :data:`CONSISTENCY_TOL` (:class:`~layershell.solver.newton.
         ActiveSetLoop`)."""
@@ -537,15 +546,50 @@ class CohesiveBlock:
         tension_changed = ((g >= 0) != tension_f) & (d_held > 0)
         loading_changed = np.where(loading_f, dt < self.d_old - tol,
                                    (dt > self.d_old + tol) & (self.d_old < FULL_DAMAGE))
+        vf = self._friction_violation(u_full, d_held)
         if not np.any(tension_changed | loading_changed):
-            return 0.0
+            return vf
         l0, _ = onset(B, self.K, self.law)
         v = np.where(loading_changed, np.abs(dt - self.d_old) * lam / l0, 0.0)
         v = np.maximum(v, np.where(tension_changed, np.clip(d_held, 0.0, 1.0) * np.abs(g) / l0, 0.0))
-        return max(float(v.max()), np.finfo(float).tiny)
+        return max(float(v.max()), np.finfo(float).tiny, vf)
+
+    #: relative tolerance of the friction's frozen stick state: a point frozen sticking whose trial
+    #: traction exceeds its slip limit by more violates it
+    STICK_TOL = 1e-9
+
+    def _friction_violation(self, u_full: np.ndarray, d: np.ndarray) -> float:
+        """The largest traction by which a point frozen sticking exceeds its slip limit, d (|t_tr|
+        - cap), as a fraction of τ_max (0 where the frozen stick state holds)."""
+        cb = self.contact
+        if cb.stick_frozen is None:
+            return 0.0
+        x = cb.slip_ratio(u_full)
+        over = cb.stick_frozen & (cb.cap > 0) & (x > 1.0 + self.STICK_TOL)
+        if not np.any(over):
+            return 0.0
+        v = (x - 1.0) * cb.cap * np.clip(d, 0.0, 1.0) / self.law.tau_max
+        return max(float(v[over].max()), np.finfo(float).tiny)
+
+    def reversal_step(self, u_full: np.ndarray, dU: np.ndarray) -> float:
+        """The largest fraction (≤ 1) of the correction ``dU`` (full space) that takes no sliding
+        friction point past its anchor, where its trial traction would reverse: a sliding point
+        has no stiffness along its slip, so a Newton correction can carry it through the stick
+        range at once and throw its friction from +cap to -cap (the TRC slab on its snap-back,
+        where all friction points near the bearing slide)."""
+        cb = self.contact
+        if cb.cap is None or not np.any(cb.cap > 0):
+            return 1.0
+        t0 = cb.trial_traction(u_full)
+        n0 = np.linalg.norm(t0, axis=-1)
+        dt = cb.trial_traction(dU, anchored=False)
+        along = np.einsum("eqi,eqi->eq", dt, t0) / np.where(n0 > 0, n0, 1.0)
+        back = (cb.cap > 0) & (n0 >= cb.cap) & (along < -n0)
+        return float((n0[back] / -along[back]).min()) if np.any(back) else 1.0
 
     def unfreeze(self) -> None:
         self.frozen = None
+        self.contact.stick_frozen = None
 
     # the attributes that assembly / results read from a block
     @property

@@ -100,6 +100,10 @@ class ContactBlock:
     t_n: np.ndarray | None = None  # (e, q, 3) converged tangential traction (upper on lower)
     g_p: np.ndarray | None = None  # (e, q, 3) slip anchor: t = α_T (P Δu - g_p) while sticking
     X0: np.ndarray | None = None  # (e, q, 3) reference positions of the points (results)
+    # (e, q) stick state frozen during a cohesive active-set solve (CohesiveBlock.freeze): a point
+    # frozen sticking keeps the stick law beyond its slip limit (the loop checks it afterwards),
+    # the others follow the return mapping; None: the return mapping everywhere
+    stick_frozen: np.ndarray | None = None
     # c (e, q, k), k = m/3: C = c ⊗ I₃ (C_iM = c_k δ_ij for M = 3k + j), the scalar weights of the
     # nodal directors in Δu; the response works with c (a third of C's size, 1/9 of its products)
     c: np.ndarray | None = None
@@ -216,6 +220,21 @@ class ContactBlock:
         """P = I - A3 ⊗ A3: tangential part along the undeformed normal, (e, q, 3, 3)."""
         return np.eye(3) - np.einsum("eqi,eqj->eqij", self.A3, self.A3)
 
+    def trial_traction(self, u_full: np.ndarray, du: np.ndarray | None = None, anchored: bool = True) -> np.ndarray:
+        """Trial friction traction t_tr = α_T (P Δu - g_p) (e, q, 3) (``du``: Δu at ``u_full`` if
+        known); not ``anchored``: α_T P Δu, the change of t_tr for an increment ``u_full``."""
+        P = self.projector()
+        du = self.relative_displacement(u_full) if du is None else du
+        gT = np.einsum("eqij,eqj->eqi", P, du)
+        aT = np.asarray(self.alpha_T, float)
+        return (aT[..., None] if aT.ndim else aT) * (gT - self.g_p if anchored else gT)
+
+    def slip_ratio(self, u_full: np.ndarray, du: np.ndarray | None = None) -> np.ndarray:
+        """x = |t_tr| / cap (e, q): above 1 the point slides (0 where no friction acts)."""
+        n = np.linalg.norm(self.trial_traction(u_full, du), axis=-1)
+        on = self.released & (self.cap > 0)
+        return np.where(on, n / np.where(on, self.cap, 1.0), 0.0)
+
     def friction_traction(self, u_full: np.ndarray, du: np.ndarray | None = None):
         """Penalty friction by return mapping: with the trial t_tr = α_T (P Δu - g_p) the traction is
         t = cap f(|t_tr|/cap) t_tr/|t_tr| with f(x) = min(x, 1) (FRICTION_SHARPNESS = inf): stick
@@ -225,18 +244,20 @@ class ContactBlock:
         the upper layer on the lower one per area) and its consistent tangent dt/dΔu (e, q, 3, 3):
         α_T P sticking, α_T cap/|t_tr| (I - e⊗e) P sliding (symmetric: e lies in the tangent
         plane). α_T is a number or one per point (e, q). ``du``: the relative displacement at
-        ``u_full`` if already known."""
+        ``u_full`` if already known. Points frozen sticking (``stick_frozen``) keep the stick law
+        t = t_tr beyond the limit."""
         P = self.projector()
-        du = self.relative_displacement(u_full) if du is None else du
-        gT = np.einsum("eqij,eqj->eqi", P, du)
+        t_tr = self.trial_traction(u_full, du)
         aT = np.asarray(self.alpha_T, float)
         aT = aT[..., None] if aT.ndim else aT  # one per point: (e, q, 1)
-        t_tr = aT * (gT - self.g_p)
         n = np.linalg.norm(t_tr, axis=-1)
         on = self.released & (self.cap > 0)
         cap = np.where(on, self.cap, 1.0)
         x = n / cap
         f_over_x, fprime = friction_shape(x)
+        if self.stick_frozen is not None:
+            f_over_x = np.where(self.stick_frozen, 1.0, f_over_x)
+            fprime = np.where(self.stick_frozen, 1.0, fprime)
         e = t_tr / np.where(n > 0, n, 1.0)[..., None]
         ee = np.einsum("eqi,eqj->eqij", e, e)
         dtdtr = f_over_x[..., None, None] * (np.eye(3) - ee) + fprime[..., None, None] * ee

@@ -40,10 +40,11 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .newton import (MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError, NewtonSettings, StepResult,
-                     active_set_blocks, at_round_off_floor, check_stabilised_step, cohesive_hint, contact_hint,
-                     contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze, newton, reaction_scale,
-                     record_scale, relax, resolve, stabilise, stagnates, start_inertia)
+from .newton import (FRICTION_STAGNATION, MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError,
+                     NewtonSettings, StepResult, active_set_blocks, at_round_off_floor, check_stabilised_step,
+                     cohesive_hint, contact_hint, contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze,
+                     friction_acts, newton, reaction_scale, record_scale, relax, resolve, stabilise, stagnates,
+                     start_inertia)
 from .problem import Problem
 
 
@@ -427,7 +428,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         att.best, att.early = None, False
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
-                                                s.stagnation_iterations if blocks else 0, f_itf0,
+                                                stagnation_window(s, blocks), f_itf0,
                                                 early=early, at_start=(q, R0))
         if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
                 and any(b.set_changed(att.best[1]) for b in blocks)):
@@ -580,10 +581,45 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
                 att.message = "the dissipation constraint does not depend on λ here"
                 return dur, dlam, False
             dl = -gc / dg
-        dur = dur + a + dl * b
-        dlam += dl
+        eta = reversal_step(problem, u, op.expand(a + dl * b) + (dl * g if g is not None else 0.0))
+        dur = dur + eta * (a + dl * b)
+        dlam += eta * dl
     att.message = f"no convergence in {max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
     return dur, dlam, False
+
+
+#: the smallest fraction of a Newton correction that :func:`reversal_step` takes
+REVERSAL_STEP_MIN = 0.05
+
+
+def reversal_step(problem: Problem, u: np.ndarray, dU: np.ndarray) -> float:
+    """The fraction of the correction ``dU`` (full space) at the iterate ``u`` that the Newton
+    iterations take: where friction acts on the damaged share of a cohesive interface, the
+    largest that carries no sliding point past its anchor
+    (:meth:`~layershell.cohesive.CohesiveBlock.reversal_step`), at least
+    :data:`REVERSAL_STEP_MIN`; 1 elsewhere. The stopped point then sticks, and the next
+    iteration has its stick stiffness. (The TRC slab by arc length on 8 × 6 stopped at
+    306.68 kN/m² on its snap-back, its residual stalled at 0.25 kN as about 30 sliding points
+    reversed together from one iterate to the next; restarted there with the frozen stick state
+    and this limit it went on to 302.76, and from the start, with :data:`FRICTION_REFUSED`'s
+    growth too, down to 288.16.)"""
+    eta = 1.0
+    for blk in problem.assembler.extra:
+        if hasattr(blk, "reversal_step"):
+            eta = min(eta, blk.reversal_step(u, dU))
+    return max(eta, REVERSAL_STEP_MIN)
+
+
+def stagnation_window(s: NewtonSettings, blocks: list) -> int:
+    """Iterations without progress after which a frozen cohesive solve of an arc-length increment
+    gives up (:func:`~layershell.solver.newton.stagnates`): ``stagnation_iterations``, at least
+    :data:`~layershell.solver.newton.FRICTION_STAGNATION` where friction acts on a damaged share
+    (its limited steps make slower progress), 0 (never) without cohesive blocks."""
+    if not blocks:
+        return 0
+    if s.stagnation_iterations > 0 and friction_acts(blocks):
+        return max(s.stagnation_iterations, FRICTION_STAGNATION)
+    return s.stagnation_iterations
 
 
 def _release_closed(asm, u: np.ndarray) -> None:
@@ -699,6 +735,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
         total_it, cuts, resolves = 0, 0, 0
+        grown, size_refused = 0, 0.0  # growths of an increment refused as friction's (FRICTION_REFUSED)
         e0 = dissipation_so_far(problem)
         residuals: list[float] = []
         allow_jump = tried_dissipation = False
@@ -794,7 +831,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         ok, msg = False, "the dissipation constraint was met by closure, not damage"
                 elif (att.lam < lam and problem.interfaces.cohesive()
                       and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
-                    ok, msg = False, "the dissipation constraint was met by friction on unloading, not by damage"
+                    ok, msg = False, FRICTION_REFUSED
             if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
@@ -828,6 +865,20 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 cuts += 1
                 st.size *= max(0.25, min(0.5, 0.8 / e_rel))
                 continue
+            if msg == FRICTION_REFUSED and friction_acts(active_set_blocks(problem)[0]):
+                # too short an increment to damage: the constraint (secant unloading) is met by
+                # the energy that the friction's stick springs and the contact give back - a longer
+                # one damages. The TRC slab on 16 × 12 crawled on its snap-back at 305.90 kN/m²:
+                # increments of Δτ = 10⁻¹¹-10⁻⁷ booked 2·10⁻¹¹-4·10⁻¹⁰ of damage, refused from
+                # 3·10⁻¹¹ on and cut, while 10⁻⁶ to 10⁻³ booked 81-100 % (docs/performance.md).
+                # Where growing does not help (elastic unloading), cut from the refused size
+                if grown < GROW_REFUSED:
+                    size_refused = size_refused or st.size
+                    grown += 1
+                    st.size *= GROW_FACTOR
+                    continue
+                if size_refused:
+                    st.size, size_refused = size_refused, 0.0
             if st.mode == "dissipation" and msg.startswith("no dissipation"):
                 # elastic branch: back to the arc length, its direction by the work criterion -
                 # the previous direction (a snap-back: load and displacement falling while the
@@ -1111,6 +1162,13 @@ def ledger_booked(problem: Problem) -> tuple[float, float]:
     not friction)."""
     return problem.interfaces.dissipated_total(), float(sum(problem.interfaces.dissipation()))
 
+
+#: the refusal of a force path's dissipation-controlled increment that the interfaces booked as
+#: friction rather than damage (:data:`CONSTRAINT_BOOKED`)
+FRICTION_REFUSED = "the dissipation constraint was met by friction on unloading, not by damage"
+#: such an increment is grown by GROW_FACTOR up to GROW_REFUSED times before it is cut
+GROW_FACTOR = 8.0
+GROW_REFUSED = 6
 
 #: under displacement control by arc length, a dissipation-controlled increment whose interfaces
 #: booked less than this share of the prescribed dissipation Δτ (:func:`ledger_booked`) is not

@@ -187,6 +187,11 @@ CONTACT_SET_TOL = 1e-3
 
 #: re-freezings of the cohesive sets at the best iterate of a failed frozen solve, per call of :func:`newton`
 MAX_REFREEZE = 3
+#: the stagnation window of frozen cohesive solves in arc-length increments where friction acts
+#: on a damaged share (arclength.stagnation_window): the 8 × 6 TRC slab restarted on its snap-back
+#: at 306.68 kN/m² with the frozen stick state and the reversal limit gave up after 3 iterations
+#: there and went on to 302.76 with 8
+FRICTION_STAGNATION = 8
 #: a frozen cohesive solve whose residual is within this multiple of the tolerance ends there if
 #: the sets no longer hold at its iterate: the active-set loop freezes them again at once
 #: instead of converging a frozen problem that it will discard. The frozen problems are nearly
