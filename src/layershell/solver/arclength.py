@@ -485,6 +485,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
     e0: float | None = None
     wr = arc_weights(problem)
+    friction = friction_acts(active_set_blocks(problem)[0])  # its slip limits change at commits only
     for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
@@ -581,9 +582,13 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
                 att.message = "the dissipation constraint does not depend on λ here"
                 return dur, dlam, False
             dl = -gc / dg
-        eta = reversal_step(problem, u, op.expand(a + dl * b) + (dl * g if g is not None else 0.0))
-        dur = dur + eta * (a + dl * b)
-        dlam += eta * dl
+        eta = reversal_step(problem, u, op.expand(a + dl * b) + (dl * g if g is not None else 0.0)) if friction else 1.0
+        if eta < 1.0:
+            dur = dur + eta * (a + dl * b)
+            dlam += eta * dl
+        else:  # (the full correction, in the same floating-point order as without friction)
+            dur = dur + a + dl * b
+            dlam += dl
     att.message = f"no convergence in {max_iterations} iterations (last residual {att.residuals[-1]:.3e})"
     return dur, dlam, False
 
