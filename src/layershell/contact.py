@@ -220,14 +220,20 @@ class ContactBlock:
         """P = I - A3 ⊗ A3: tangential part along the undeformed normal, (e, q, 3, 3)."""
         return np.eye(3) - np.einsum("eqi,eqj->eqij", self.A3, self.A3)
 
-    def trial_traction(self, u_full: np.ndarray, du: np.ndarray | None = None, anchored: bool = True) -> np.ndarray:
-        """Trial friction traction t_tr = α_T (P Δu - g_p) (e, q, 3) (``du``: Δu at ``u_full`` if
-        known); not ``anchored``: α_T P Δu, the change of t_tr for an increment ``u_full``."""
-        P = self.projector()
+    def _penalty(self):
+        """α_T broadcastable against (e, q, 3): the number, or (e, q, 1) for one per point."""
+        aT = np.asarray(self.alpha_T, float)
+        return aT[..., None] if aT.ndim else aT
+
+    def trial_traction(self, u_full: np.ndarray, du: np.ndarray | None = None, anchored: bool = True,
+                       P: np.ndarray | None = None) -> np.ndarray:
+        """Trial friction traction t_tr = α_T (P Δu - g_p) (e, q, 3) (``du``: Δu at ``u_full`` and
+        ``P``: :meth:`projector`, if known); not ``anchored``: α_T P Δu, the change of t_tr for an
+        increment ``u_full``."""
+        P = self.projector() if P is None else P
         du = self.relative_displacement(u_full) if du is None else du
         gT = np.einsum("eqij,eqj->eqi", P, du)
-        aT = np.asarray(self.alpha_T, float)
-        return (aT[..., None] if aT.ndim else aT) * (gT - self.g_p if anchored else gT)
+        return self._penalty() * (gT - self.g_p if anchored else gT)
 
     def slip_ratio(self, u_full: np.ndarray, du: np.ndarray | None = None) -> np.ndarray:
         """x = |t_tr| / cap (e, q): above 1 the point slides (0 where no friction acts)."""
@@ -247,9 +253,8 @@ class ContactBlock:
         ``u_full`` if already known. Points frozen sticking (``stick_frozen``) keep the stick law
         t = t_tr beyond the limit."""
         P = self.projector()
-        t_tr = self.trial_traction(u_full, du)
-        aT = np.asarray(self.alpha_T, float)
-        aT = aT[..., None] if aT.ndim else aT  # one per point: (e, q, 1)
+        t_tr = self.trial_traction(u_full, du, P=P)
+        aT = self._penalty()
         n = np.linalg.norm(t_tr, axis=-1)
         on = self.released & (self.cap > 0)
         cap = np.where(on, self.cap, 1.0)

@@ -485,7 +485,7 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
     first = len(att.residuals)  # this call's residuals: att.residuals[first:]
     e0: float | None = None
     wr = arc_weights(problem)
-    friction = friction_acts(active_set_blocks(problem)[0])  # its slip limits change at commits only
+    friction = _friction_acts(problem)  # its slip limits change at commits only
     for it in range(max_iterations + 1):
         lam = lam0 + dlam
         u = u0 + op.expand(dur)
@@ -613,6 +613,11 @@ def reversal_step(problem: Problem, u: np.ndarray, dU: np.ndarray) -> float:
         if hasattr(blk, "reversal_step"):
             eta = min(eta, blk.reversal_step(u, dU))
     return max(eta, REVERSAL_STEP_MIN)
+
+
+def _friction_acts(problem: Problem) -> bool:
+    """Does friction act on the damaged share of a cohesive interface of ``problem``?"""
+    return friction_acts(active_set_blocks(problem)[0])
 
 
 def stagnation_window(s: NewtonSettings, blocks: list) -> int:
@@ -870,7 +875,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 cuts += 1
                 st.size *= max(0.25, min(0.5, 0.8 / e_rel))
                 continue
-            if msg == FRICTION_REFUSED and friction_acts(active_set_blocks(problem)[0]):
+            if msg == FRICTION_REFUSED and _friction_acts(problem):
                 # too short an increment to damage: the constraint (secant unloading) is met by
                 # the energy that the friction's stick springs and the contact give back - a longer
                 # one damages. The TRC slab on 16 × 12 crawled on its snap-back at 305.90 kN/m²:
