@@ -911,8 +911,10 @@ def test_a_dissipation_increment_too_short_to_damage_is_grown_where_friction_act
     energy that the stick springs and the contact give back (the TRC slab on 16 × 12 crawled so on
     its snap-back at 305.90 kN/m²: Δτ = 10⁻¹¹-10⁻⁷ booked 2·10⁻¹¹-4·10⁻¹⁰, while 10⁻⁶-10⁻³ booked
     81-100 %). It is grown GROW_FACTOR times, at most GROW_REFUSED times, before it is cut; without
-    friction, or where growing does not help, the refusal goes on as before (cut, then the arc
-    length, which here rises). Stand-ins: the dissipation constraint converges with λ falling, the
+    friction, where growing does not help, or where the refused increment is already longer than
+    the last accepted one (it went astray: the slab at 300.14 kN/m², Δτ = 8·10⁻⁵ to 143.7 kN/m²,
+    grown to -305 and -132), the refusal goes on as before (cut, then the arc length, which here
+    rises). Stand-ins: the dissipation constraint converges with λ falling, the
     arc length with λ rising, a ledger that books an increment's Δτ as damage from ``least`` on."""
     from layershell.solver import arclength as al
     from layershell.solver.newton import NewtonSettings
@@ -937,10 +939,13 @@ def test_a_dissipation_increment_too_short_to_damage_is_grown_where_friction_act
     pb = _stand_in_problem(booked)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
-    for friction, least, expected, grown in ((True, 1e-3, 0.49, 3), (False, 1e-3, 0.51, 0),
-                                             (True, 1e3, 0.51, al.GROW_REFUSED)):
+    # the refused increments are 1e-3 per DOF long (1.41e-3); the last accepted one was 1 long, or
+    # 1e-3 in the last case: a refused increment longer than that went astray and is cut at once
+    for friction, least, expected, grown, last in ((True, 1e-3, 0.49, 3, 1.0), (False, 1e-3, 0.51, 0, 1.0),
+                                                   (True, 1e3, 0.51, al.GROW_REFUSED, 1.0),
+                                                   (True, 1e-3, 0.51, 0, 1e-3)):
         booked["damage"], acts["friction"], tried[:] = 0.0, friction, []
-        st0 = al.PathState(mode="dissipation", size=1e-5, arc_length=1.0, lam_peak=0.5, arc_length0=1.0)
+        st0 = al.PathState(mode="dissipation", size=1e-5, arc_length=last, lam_peak=0.5, arc_length0=1.0)
         steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
                                    on_step_end=on_step_end))
         assert [s.load_factor for s in steps] == pytest.approx([expected])

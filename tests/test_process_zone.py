@@ -97,6 +97,35 @@ def test_reaction_floor_is_at_least_a_millionth_of_the_force_scale():
     assert len(msgs) == 1 and "'P'" in msgs[0]  # P grew 4x while λ hardly changed: still a jump
 
 
+def test_debonded_area_probe_is_judged_by_its_share_of_the_interface():
+    """A debonded-area probe grows by whole nodal areas: its ratio between two steps measures the
+    mesh, not a jump. The TRC slab on 16 × 12 by arc length, on its snap-back at 306 kN/m², had
+    every converged increment refused as a 'probe jump' because the debonded area went from one
+    node's share to five (0.00041446 to 0.0020723 m², 5×) - of a 3 m² interface - and the run
+    stopped there. Its floor (runner._ProbeFloors) is the area rule's share (``jump_area``) of the
+    area the probe watches: the quarter's interface, 2 m × 1.5 m, for the whole-interface probe;
+    a part of it for the probe near the bearings. Below the floor no ratio counts; above it,
+    e.g. from 0.5 to 1.6 m² (a third of the interface at once), it still does."""
+    from helpers import example_spec
+    from layershell.runner import _ProbeFloors
+
+    spec = example_spec("slab_trc_soffit", {"sigma_max = 1980.0": 'law = "cohesive"\nsigma_max = 1980.0',
+                                            "mu0 = 0.95": "G_Ic = 0.14\nG_IIc = 0.50\neta = 2.0\nmu0 = 0.95"})
+    pb = Problem.build(spec.model)
+    pb.force_scale = 900.0
+    floors = _ProbeFloors(spec, pb)(np.zeros(pb.dm.n_full))
+    jump_area = spec.source.steps.jump_area
+    assert jump_area == 0.2  # the default
+    assert floors["debonded"] == pytest.approx(jump_area * 2.0 * 1.5, rel=1e-9)
+    # x < 0.3 or y < 0.3, sampled at the interface points: about 0.3·1.5 + 2·0.3 - 0.09 = 0.96 m²
+    assert 0.15 * floors["debonded"] < floors["debonded_support"] < 0.5 * floors["debonded"]
+    probes, prev = {"debonded": 0.0020723, "w_mid": 30.1}, {"debonded": 0.00041446, "w_mid": 30.0}
+    assert jump_warnings(279, 305.687, 306.022, None, None, probes, prev, None, 3.0)  # the ratio alone: 'jump'
+    assert not jump_warnings(279, 305.687, 306.022, None, None, probes, prev, None, 3.0, None, floors)
+    assert jump_warnings(279, 290.0, 300.0, None, None, {"debonded": 1.6}, {"debonded": 0.5}, None, 3.0, None,
+                         floors)
+
+
 # ---------------------------------------------------------------------- process-zone length
 from layershell.cohesive import FULL_DAMAGE  # noqa: E402
 from layershell.io.build import build, parse  # noqa: E402

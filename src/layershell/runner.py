@@ -165,7 +165,14 @@ class _ProbeFloors:
     solver/newton.py), so by Cauchy–Schwarz it is resolved only beyond
     |scale| · ‖ρ‖ · tol_residual · force_scale. Below that it is round-off - e.g. the sum of the
     reactions that equilibrium makes zero (the DCB's P_all: ~1e-8 N against 60 N loads) - and
-    its ratio between two steps means nothing. Other probes get no floor.
+    its ratio between two steps means nothing.
+
+    A debonded-area probe grows by whole nodal areas, so its ratio between two steps measures the
+    mesh, not a jump: the TRC slab on 16 × 12, on its snap-back, had increments refused as jumps
+    because the debonded area went from one node's share to five (0.0004 to 0.002 m², 5×, of the
+    3 m² interface). The debonded area is judged by its share of the interface instead
+    (``jump_area``, :func:`~layershell.solver.arclength.jump_warnings`), so its floor is that share
+    of the area the probe watches: below it the ratio is not checked. Other probes get no floor.
 
     The floor is at least ``RELATIVE`` (10⁻⁶) of the force scale: a reaction that small is not
     resolved either where it is not one that equilibrium makes zero - the DCB opened by
@@ -189,7 +196,12 @@ class _ProbeFloors:
         scale = float(getattr(pb, "force_scale", 0.0)) * spec.newton.tol_residual
         out = {}
         largest = float(np.abs(u[self.translations]).max(initial=0.0)) if u is not None else 0.0
+        jump_area = spec.source.steps.jump_area
         for p in spec.probes:
+            if p.quantity == "debonded_area" and jump_area is not None:
+                if p.name not in self.norms:  # the interface area the probe watches
+                    self.norms[p.name] = p.debonded_area(pb.interfaces, whole=True)
+                out[p.name] = abs(p.scale) * jump_area * self.norms[p.name]
             if p.quantity == "displacement" and u is not None:
                 out[p.name] = abs(p.scale) * self.DISPLACEMENT * largest
             if p.quantity != "reaction":

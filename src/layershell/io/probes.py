@@ -73,14 +73,15 @@ class Probe:
                 vals = np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
         return self.scale * vals
 
-    def debonded_area(self, interfaces) -> float:
-        """Released area of the interfaces below ``layer`` (points selected by ``where``)."""
+    def debonded_area(self, interfaces, whole: bool = False) -> float:
+        """Released area of the interfaces below ``layer`` (points selected by ``where``);
+        ``whole``: the area of all those points, released or not (the area the probe watches)."""
         area = 0.0
         for r in interfaces.runs if interfaces is not None else ():
             blk = r.block
             if blk.itf.upper != self.layer:
                 continue
-            counted = blk.released
+            counted = np.ones_like(blk.released) if whole else blk.released
             if self.where is not None:
                 X = blk.X0
                 inside = np.asarray(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), bool)

@@ -461,7 +461,9 @@ class Steps(Strict):
         "first")
     jump_ratio: float | None = Field(
         3.0, gt=1, description="warn when a probe grows more than this many times as fast as λ in one step "
-        "(|v/v_prev| > jump_ratio · max(1, λ/λ_prev)); adaptive and arc-length control cut such a step first")
+        "(|v/v_prev| > jump_ratio · max(1, λ/λ_prev)); adaptive and arc-length control cut such a step first. A "
+        "debonded_area probe only once it exceeds jump_area of the interface area it watches (it grows by whole "
+        "nodal areas)")
     energy_tolerance: float = Field(
         0.02, ge=0, lt=1, description="control = 'arc_length', cohesive interfaces: once the run's energy balance "
         "error (external work − stored energy − dissipated, summary.json 'energy') exceeds 0.5 %, an increment "

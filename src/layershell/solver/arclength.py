@@ -881,8 +881,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # one damages. The TRC slab on 16 × 12 crawled on its snap-back at 305.90 kN/m²:
                 # increments of Δτ = 10⁻¹¹-10⁻⁷ booked 2·10⁻¹¹-4·10⁻¹⁰ of damage, refused from
                 # 3·10⁻¹¹ on and cut, while 10⁻⁶ to 10⁻³ booked 81-100 % (docs/performance.md).
-                # Where growing does not help (elastic unloading), cut from the refused size
-                if grown < GROW_REFUSED:
+                # Where growing does not help (elastic unloading), cut from the refused size. An
+                # increment longer than the last accepted one went astray instead (the same slab,
+                # at 300.14 kN/m² after a node had debonded fully: Δτ = 8·10⁻⁵ ended at 143.7
+                # kN/m², grown ones at -305 and -132): it is cut
+                if grown < GROW_REFUSED and increment_length(problem, att.u - u) < st.arc_length:
                     size_refused = size_refused or st.size
                     grown += 1
                     st.size *= GROW_FACTOR
@@ -1015,7 +1018,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
         else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
             # down where this one was longer (else a short bond's peak lies inside one increment)
-            dun = float(np.linalg.norm(du[problem.op.independent] * arc_weights(problem)))
+            dun = increment_length(problem, du)
             st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
             st.arc_length = max(min(dun, dl_max), dl_min)
             if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
@@ -1115,6 +1118,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             # where the constrained iterations on frozen sets have no solution), as long as λ rises
             rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)
             recent, recent_dG = [], []
+
+
+def increment_length(problem: Problem, du: np.ndarray) -> float:
+    """The length of the increment ``du`` (full space) in the arc length's measure: the
+    independent DOFs, each director's coefficient times t^l (:func:`arc_weights`)."""
+    return float(np.linalg.norm(du[problem.op.independent] * arc_weights(problem)))
 
 
 def _may_rescue(ps: PathSettings, arc: bool, lam: float) -> bool:
