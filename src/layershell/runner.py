@@ -188,7 +188,8 @@ class _ProbeFloors:
 
     def __init__(self, spec: RunSpec, problem: Problem):
         self.spec, self.problem = spec, problem
-        self.norms: dict[str, float] = {}
+        self.norms: dict[str, float] = {}  # ‖ρ‖ of each reaction probe
+        self.areas: dict[str, float] = {}  # the interface area each debonded-area probe watches
         self.translations = problem.dm.translations()
 
     def __call__(self, u: np.ndarray | None = None) -> dict[str, float]:
@@ -199,9 +200,9 @@ class _ProbeFloors:
         jump_area = spec.source.steps.jump_area
         for p in spec.probes:
             if p.quantity == "debonded_area" and jump_area is not None:
-                if p.name not in self.norms:  # the interface area the probe watches
-                    self.norms[p.name] = p.debonded_area(pb.interfaces, whole=True)
-                out[p.name] = abs(p.scale) * jump_area * self.norms[p.name]
+                if p.name not in self.areas:
+                    self.areas[p.name] = p.debonded_area(pb.interfaces, whole=True)
+                out[p.name] = abs(p.scale) * jump_area * self.areas[p.name]
             if p.quantity == "displacement" and u is not None:
                 out[p.name] = abs(p.scale) * self.DISPLACEMENT * largest
             if p.quantity != "reaction":

@@ -1353,7 +1353,7 @@ def arc_weights(problem: Problem) -> np.ndarray:
 
 def _first_dissipation(problem: Problem, u: np.ndarray, lam: float, dl: float) -> float:
     """A first Δτ: the elastic energy ½ λ F̂ᵀu times the relative size of the arc length."""
-    un = float(np.linalg.norm(u[problem.op.independent] * arc_weights(problem)))
+    un = increment_length(problem, u)  # the state's length from 0
     return 0.5 * abs(lam * sum(conjugates(problem, u))) * min(1.0, dl / max(un, 1e-300)) * 0.5
 
 
