@@ -734,6 +734,51 @@ def test_friction_stick_state_is_frozen_with_the_cohesive_sets():
     np.testing.assert_allclose(t[e, q], cb.cap[e, q] * n, rtol=1e-9, atol=1e-12 * cb.cap[e, q])
 
 
+def _push_over_limit(cb, u, e, q, factor):
+    """Move the anchor of point (e, q) so that its trial traction is ``factor`` × its slip limit."""
+    t_tr = cb.trial_traction(u)[e, q]
+    n = t_tr / np.linalg.norm(t_tr)
+    cb.g_p[e, q] += (t_tr - factor * cb.cap[e, q] * n) / np.asarray(cb.alpha_T, float)[e, q]
+
+
+def test_the_cycle_key_of_the_active_set_loop_holds_the_friction_stick_state():
+    """The active-set loop counts how often it froze each state and gives up on a third time
+    (freeze_sets: a cycle). The friction's stick state is frozen with the cohesive sets
+    (CohesiveBlock.freeze), so it belongs to the state: counted by (tension, loading) only, a loop
+    in which the loading sets held and only stick points went over their limits was 'cycling'
+    after its second refreeze (the sampled ones 1.0-7.6·10⁻³ of the strength from consistency,
+    against the tolerance of 10⁻³), and the TRC slab on its snap-back refused most of
+    its small increments so (8 × 6: 319 of 406 refusals in its first 390 increments). Now the
+    key (CohesiveBlock.frozen_key) holds the stick state: freezes that differ in it are different
+    states, the same frozen state a third time still is a cycle, and the loading sets stay known
+    to the loop's limited refreeze (ActiveSetLoop). Checked on the 6 × 6 plate at λ = 1 with
+    anchors moved as a solve would move the points."""
+    from layershell.solver.newton import _sets_key, freeze_sets
+
+    pb, blk, u = _plate_with_friction_at_full_load()
+    cb = blk.contact
+    seen: dict = {}
+    assert freeze_sets([blk], u, seen)
+    sticking = np.argwhere((cb.cap > 0) & cb.stick_frozen & (blk.d_old > 0))
+    assert len(sticking) >= 2
+    (e1, q1), (e2, q2) = sticking[:2]
+    sets = _sets_key([blk.frozen])
+    for e, q in ((e1, q1), (e2, q2)):  # a solve carried one more stick point over its limit
+        _push_over_limit(cb, u, e, q, 1.5)
+        assert blk.set_violation(u) > blk.CONSISTENCY_TOL
+        assert freeze_sets([blk], u, seen)  # the same loading sets, another stick state: no repeat
+        assert not cb.stick_frozen[e, q] and _sets_key([blk.frozen]) == sets
+    assert sets in seen and _sets_key([blk.actual_sets(u)]) in seen  # for the limited refreeze
+    # the same frozen state again: the second time is allowed, the third is a cycle
+    assert freeze_sets([blk], u, seen)
+    assert not freeze_sets([blk], u, seen)
+    # a loop without friction counts as before: (tension, loading)
+    blk.unfreeze()
+    blk.freeze(u)
+    cb.stick_frozen = None
+    assert blk.frozen_key() == sets
+
+
 def test_reversal_step_stops_a_sliding_point_at_its_anchor():
     """A sliding point has no stiffness along its slip, so a Newton correction can carry it through
     its stick range at once and throw its friction from +cap to -cap (the TRC slab stalled so on

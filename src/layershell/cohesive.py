@@ -491,6 +491,15 @@ class CohesiveBlock:
             # do not switch between stick and slip from one iterate to the next
             cb.stick_frozen = cb.slip_ratio(u_full) < 1.0
 
+    def frozen_key(self) -> bytes:
+        """The frozen state as the active-set loop's cycle detection compares it: tension,
+        loading and, where friction acts, the stick state - a loop whose stick state changes is
+        not repeating itself (:func:`~layershell.solver.newton.freeze_sets`)."""
+        arrays = list(self.frozen) if self.frozen is not None else []
+        if self.contact.stick_frozen is not None:
+            arrays.append(self.contact.stick_frozen)
+        return b"".join(np.packbits(a).tobytes() for a in arrays)
+
     def release_closed(self, u_full: np.ndarray) -> int:
         """Take the points frozen as opening and loading whose normal separation is negative at
         ``u_full`` out of both sets (closed, damage held); returns how many.
