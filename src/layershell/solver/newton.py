@@ -476,7 +476,8 @@ def freeze_sets(blocks: list, u: np.ndarray, seen: dict[bytes, int] | None) -> b
         b.freeze(u, limited=limited)
     seen.setdefault(_sets_key([b.frozen for b in blocks]), 0)  # the loading sets (for ``limited``)
     # the count: of the whole frozen state, the friction's stick state included (frozen_key)
-    key = b"F" + b"".join(b.frozen_key() if hasattr(b, "frozen_key") else _sets_key([b.frozen]) for b in blocks)
+    # (``seen`` is kept only where every block is cohesive: active_set_blocks' ``cohesive_only``)
+    key = b"F" + b"".join(b.frozen_key() for b in blocks)
     seen[key] = seen.get(key, 0) + 1
     return seen[key] <= 2
 
