@@ -335,3 +335,25 @@ def test_run_good_example_writes_summary(outcomes):
     assert summary["converged"] is True
     assert "w_tip" in summary["probes"]
     assert not list((o.out_dir / "good_run").glob("*.vtu"))
+
+
+def test_a_run_stopped_after_its_peak_names_the_peak_instead_of_the_support_hint():
+    """A path-following run that stops on the branch after a peak of its load factor (the TRC
+    slab by arc length on 8 × 6 stopped at 266.28 kN/m² after its peak of 327.12) gets advice
+    that names the peak and its step and says that the steps up to there are equilibrium states,
+    not the generic hint about supports and step sizes (which a structure that carried the peak
+    does not need). A run whose last load factor is within 1 % of its largest (a load-controlled
+    run that failed on its way up) keeps the generic hint."""
+    from layershell.cli import POST_PEAK, _post_peak_cause
+
+    def summary(lams):
+        return {"steps": [{"step": i + 1, "load_factor": x} for i, x in enumerate(lams)]}
+
+    said = _post_peak_cause(summary([100.0, 250.0, 327.12, 300.0, 266.28]))
+    assert said is not None
+    assert "327.12 at step 3" in said and "18.6% below it" in said and "equilibrium states" in said
+    assert "supports" not in said
+    assert _post_peak_cause(summary([100.0, 250.0, 327.12])) is None  # stopped on its way up
+    assert _post_peak_cause(summary([100.0, 327.12, 327.12 * (1 - 0.5 * POST_PEAK)])) is None  # at the peak
+    assert _post_peak_cause(summary([])) is None and _post_peak_cause({}) is None
+    assert _post_peak_cause(summary([0.0, -1.0])) is None  # no positive peak

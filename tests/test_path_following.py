@@ -1058,3 +1058,51 @@ def test_the_path_state_survives_a_checkpoint_whole():
     old.update({"path.last_increment": np.array(0.01), "path.last_iterations": np.array(6)})
     back = al.PathState.from_arrays(old)
     assert back.recent == [(0.01, 6)] and back.recent_mode == "load"
+
+
+def test_the_arc_length_takes_over_a_failed_dissipation_increment_from_a_length_it_can_cut(monkeypatch):
+    """Where the dissipation constraint fails at all its sizes, the arc length takes the increment
+    over - from at least ARC_AFTER_DISSIPATION of its first length, not from the length of the last
+    accepted increment: after a crawl of short dissipation increments that is the smallest the arc
+    length may take, and it got one try before the run stopped (the cohesive TRC slab by arc length
+    on 8 × 6 stopped so at 266.28 kN/m²: the arc length at 4.5·10⁻⁶ failed, where 3·10⁻⁵ to 10⁻³
+    from the same state converge). Stand-ins: dissipation-controlled increments that never
+    converge, arc-length increments that converge from a length of 0.05 on (λ + 0.01), a Newton
+    solve (the load-controlled rescue) that never converges."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import ConvergenceError, NewtonResult, NewtonSettings
+
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        tried.append((mode, size))
+        ok = mode == "arc" and size >= 0.05
+        return al.Attempt(ok, u + 1e-3, lam + 0.01, 3, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
+
+    def never(problem, u, lam, s):
+        return u, NewtonResult(False, 2, [1.0], message="stand-in: diverged")
+
+    booked = {"damage": 0.0}
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0, newton=never,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]))
+    pb = _stand_in_problem(booked)
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
+    # the last accepted increment was as short as the arc length may be (1/1000 of the first)
+    st0 = al.PathState(mode="dissipation", size=1e-6, arc_length=1e-3, lam_peak=0.6, arc_length0=1.0)
+    steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                               on_step_end=lambda problem, u, lam: False))
+    assert [s.load_factor for s in steps] == pytest.approx([0.51])
+    modes = [m for m, _ in tried]
+    assert modes == ["dissipation"] * 3 + ["arc"]  # three dissipation sizes (max_cuts = 2), then the arc length
+    assert tried[-1][1] == pytest.approx(al.ARC_AFTER_DISSIPATION)
+    assert al.arc_length_restart(0.2, 1.0) == 0.2  # a longer last increment: its own length
+    # from a length below 0.05 the arc length's halvings cannot reach one that converges: the run
+    # stops (the rescue by load control fails as well) after trying the arc length at its restart length
+    tried[:] = []
+    monkeypatch.setattr(al, "ARC_AFTER_DISSIPATION", 0.04)
+    st0 = al.PathState(mode="dissipation", size=1e-6, arc_length=1e-3, lam_peak=0.6, arc_length0=1.0)
+    with pytest.raises(ConvergenceError):
+        list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                           on_step_end=lambda problem, u, lam: False))
+    assert ("arc", pytest.approx(0.04)) in tried and all(size <= 0.04 for m, size in tried if m == "arc")

@@ -379,10 +379,38 @@ def _report_failure(model: Path, res, out_dir: Path | None = None) -> None:
     elif "the regularisation, not the interface, carries the load" in msg:  # stabilised (solver/newton.py)
         cause = "the load factors beyond the limit point are not equilibrium states of the rate-independent law"
     else:
-        cause = ("check that the supports prevent every rigid-body motion (3 translations and 3 rotations); if "
-                 "they do, the load may pass a limit point or be too large for one step: use more load steps "
-                 "([steps] n), a smaller lambda_end, or larger max_iterations / max_bisections")
+        cause = _post_peak_cause(res.summary) or (
+            "check that the supports prevent every rigid-body motion (3 translations and 3 rotations); if "
+            "they do, the load may pass a limit point or be too large for one step: use more load steps "
+            "([steps] n), a smaller lambda_end, or larger max_iterations / max_bisections")
     _fail(f"{model}: the solution failed: {msg}; {cause}; {kept}", 1)
+
+
+#: a run whose last converged load factor lies more than this share below the largest one before it
+#: stopped on a branch after a peak (:func:`_post_peak_cause`)
+POST_PEAK = 0.01
+
+
+def _post_peak_cause(summary: dict) -> str | None:
+    """The advice for a run that stopped after passing a peak of its load factor (arc length, or a
+    prescribed displacement that softens): the peak, where it was reached, and that the path
+    stopped on a falling branch - not the generic hint about supports and step sizes, which
+    a structure that carried the peak does not need. None where the last converged load factor is
+    within POST_PEAK of the largest one (or no step converged)."""
+    steps = summary.get("steps") or []
+    lams = [st.get("load_factor") for st in steps]
+    if not lams or any(not isinstance(x, (int, float)) for x in lams):
+        return None
+    k = max(range(len(lams)), key=lambda i: lams[i])
+    peak, last = lams[k], lams[-1]
+    if not peak > 0.0 or not last < (1.0 - POST_PEAK) * peak:
+        return None
+    return (f"the path had passed a peak of the load factor, {peak:.6g} at step {steps[k].get('step', k + 1)}, "
+            f"and stopped {1.0 - last / peak:.1%} below it on the branch after it: the steps up to here, the peak "
+            "included, are equilibrium states; past a peak a quasi-static path can end where it branches "
+            "or where the debonding or the friction jumps, and a later branch may rise again, so the peak "
+            "is the first limit load, not necessarily the capacity (a finer mesh along the debonding front "
+            "may pass such a stop)")
 
 
 def _guarded(what: str, fn, *args, **kwargs):

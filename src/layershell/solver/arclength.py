@@ -948,8 +948,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if st.mode == "dissipation":  # once per increment: then the arc length alone
                     # its direction by the work criterion, as after "no dissipation" above: past a
-                    # snap-back the previous direction follows elastic unloading down to λ = 0
-                    st.mode, st.size, st.changed = "arc", st.arc_length, True
+                    # snap-back the previous direction follows elastic unloading down to λ = 0.
+                    # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
+                    st.mode, st.size, st.changed = "arc", arc_length_restart(st.arc_length, st.arc_length0), True
                     cuts, tried_dissipation = 0, True
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
@@ -1236,6 +1237,24 @@ def size_insensitive(size: float, its: int, recent: list[tuple[float, int]], tar
 
 #: arc-length control: the increments :func:`size_insensitive` compares with
 ARC_WINDOW = 2
+
+
+#: where the dissipation constraint fails through its cuts, the arc length takes over from at
+#: least this share of its first length (:func:`arc_length_restart`)
+ARC_AFTER_DISSIPATION = 1.0 / 16.0
+
+
+def arc_length_restart(arc_length: float, arc_length0: float) -> float:
+    """The length from which the arc length takes over an increment that the dissipation
+    constraint could not make at any of its sizes: the length of the last accepted increment,
+    but at least ARC_AFTER_DISSIPATION × the first arc length. After a crawl of short dissipation
+    increments the last length is the smallest the arc length may take (arc_length_min, 1/1000 of
+    the first by default), and it got a single try before the run stopped: the cohesive TRC slab
+    by arc length on 8 × 6 stopped so at 266.28 kN/m² on its snap-back (Δτ down to 2·10⁻⁸ failed,
+    then the arc length at 4.5·10⁻⁶ of the first 4.5·10⁻³), where arc lengths of 3·10⁻⁵ to 10⁻³
+    from the same state converge in 10-32 iterations (either predictor direction). From the
+    longer start the usual halvings still reach the smallest length."""
+    return max(arc_length, ARC_AFTER_DISSIPATION * arc_length0)
 
 
 #: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
