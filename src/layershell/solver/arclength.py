@@ -950,7 +950,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     # its direction by the work criterion, as after "no dissipation" above: past a
                     # snap-back the previous direction follows elastic unloading down to λ = 0.
                     # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
-                    st.mode, st.size, st.changed = "arc", arc_length_restart(st.arc_length, st.arc_length0), True
+                    st.mode, st.changed = "arc", True
+                    st.size = min(arc_length_restart(st.arc_length, st.arc_length0), dl_max)
                     cuts, tried_dissipation = 0, True
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
