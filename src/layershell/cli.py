@@ -392,8 +392,9 @@ POST_PEAK = 0.01
 
 
 def _post_peak_cause(summary: dict) -> str | None:
-    """The advice for a run that stopped after passing a peak of its load factor (arc length, or a
-    prescribed displacement that softens): the peak, where it was reached, and that the path
+    """The advice for a run that stopped after passing a peak of its load factor (a path followed by
+    arc length: a force, or a prescribed displacement past a snap-back): the largest load factor,
+    where it was reached, and that the path
     stopped on a falling branch - not the generic hint about supports and step sizes, which
     a structure that carried the peak does not need. None where the last converged load factor is
     within POST_PEAK of the largest one (or no step converged)."""
@@ -408,8 +409,8 @@ def _post_peak_cause(summary: dict) -> str | None:
     return (f"the path had passed a peak of the load factor, {peak:.6g} at step {steps[k].get('step', k + 1)}, "
             f"and stopped {1.0 - last / peak:.1%} below it on the branch after it: the steps up to here, the peak "
             "included, are equilibrium states; past a peak a quasi-static path can end where it branches "
-            "or where the debonding or the friction jumps, and a later branch may rise again, so the peak "
-            "is the first limit load, not necessarily the capacity (a finer mesh along the debonding front "
+            "or where the debonding or the friction jumps, and a later branch may rise again, so this peak "
+            "is the largest load so far, not necessarily the capacity (a finer mesh along the debonding front "
             "may pass such a stop)")
 
 
