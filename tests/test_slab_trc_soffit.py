@@ -216,10 +216,11 @@ def test_cohesive_soffit_slab_by_arc_length_reaches_the_end_debonding_peak():
     one (and a debonded-area probe is no 'jump' while it is a few nodal areas, which stopped
     16 × 12 at 306.02), runs went on down by steps - 279.30 at increment 280, up elastically
     to 294.87, down again below 290 - in increments that stay small (Δτ ≈ 10⁻⁵): in one run the
-    whole snap-back, down to 237.1 and up to the second peak at 376.5 (relax: 376.6-377.1), took
-    2898 increments and 47 minutes (docs/performance.md), so the run here ends after
-    SLAB_ARC_STEPS increments (warned, 'max_steps'). Asserted: below 90 % of the peak on the
-    falling branch, with the interface still intact (before, the run stopped at 326.97 in some runs, at 306.68 in others, and
+    whole snap-back, down to 237.1 (an unloading loop, docs/performance.md, 30 Nov) and up to
+    the second peak at 376.5 (relax: 376.6-377.1), took 2898 increments and 47 minutes
+    (docs/performance.md), so the run here ends after SLAB_ARC_STEPS increments (warned,
+    'max_steps'). Asserted: below 90 % of the peak on the falling branch, with the interface
+    still intact (before, the run stopped at 326.97 in some runs, at 306.68 in others, and
     81cba8c here went down to 278.1 and up to 295.1)."""
     r = _cohesive_slab({"n = 20\n": f'n = 80\ncontrol = "arc_length"\nmax_steps = {SLAB_ARC_STEPS}\n',
                         "lambda_end = 100.0": "lambda_end = 400.0"})

@@ -394,10 +394,10 @@ POST_PEAK = 0.01
 def _post_peak_cause(summary: dict) -> str | None:
     """The advice for a run that stopped after passing a peak of its load factor (a path followed by
     arc length: a force, or a prescribed displacement past a snap-back): the largest load factor,
-    where it was reached, and that the path
-    stopped on a falling branch - not the generic hint about supports and step sizes, which
-    a structure that carried the peak does not need. None where the last converged load factor is
-    within POST_PEAK of the largest one (or no step converged)."""
+    where it was reached, and that the path stopped on a falling branch - not the generic hint
+    about supports and step sizes, which a structure that carried the peak does not need. None
+    where the last converged load factor is within POST_PEAK of the largest one (or no step
+    converged)."""
     steps = summary.get("steps") or []
     lams = [st.get("load_factor") for st in steps]
     if not lams or any(not isinstance(x, (int, float)) for x in lams):
