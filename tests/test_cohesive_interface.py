@@ -811,3 +811,64 @@ def test_reversal_step_stops_a_sliding_point_at_its_anchor():
     assert al.reversal_step(pb, u, -1e3 * c * u) == al.REVERSAL_STEP_MIN
     cb.cap = np.zeros_like(cap)
     assert blk.reversal_step(u, -c * u) == 1.0  # no friction: no limit
+
+
+def _friction_state(cap: float | None = None):
+    """_damaged_problem's strip (Lobatto) with friction on the damaged share: slip limits
+    ``cap`` at every point (random ones where None: some points stick, some slide), the stick
+    penalty per point and random anchors in the tangent plane."""
+    from layershell.cohesive import stick_penalty
+
+    pb, blk, ur = _damaged_problem("lobatto")
+    rng = np.random.default_rng(5)
+    cb = blk.contact
+    cb.cap = rng.uniform(0.0, 0.05, blk.d_old.shape) if cap is None else np.full(blk.d_old.shape, cap)
+    cb.alpha_T = stick_penalty(blk.K, cb.cap, blk.law.tau_max)
+    cb.g_p = np.einsum("eqij,eqj->eqi", cb.projector(), rng.normal(size=cb.g_p.shape)) * 1e-6
+    return pb, blk, ur
+
+
+def test_friction_excess_gradient_against_finite_differences():
+    """∂c/∂u of CohesiveBlock.friction_excess (the secant energy of the friction on the damaged
+    share less its stored energy) equals central differences of c in a state with sticking and
+    sliding points whose damage grows at some of them."""
+    from layershell.solver.arclength import friction_excess
+
+    pb, blk, ur = _friction_state()
+    u = pb.op.T @ ur
+    x = blk.contact.slip_ratio(u)
+    on = blk.contact.cap > 0
+    assert (x[on] > 1).any() and (x[on] < 1).any()  # some points slide, some stick
+    _, _, d, _ = blk.point_state(u)
+    assert ((d > blk.d_old) & on).any()  # damage grows under friction somewhere
+    c, grad = friction_excess(pb, u, True)
+    assert c != 0.0
+    rng = np.random.default_rng(11)
+    for _ in range(3):
+        v = pb.op.T @ rng.normal(size=ur.size) * (1e-7 * np.abs(ur).max())
+        fd = (friction_excess(pb, u + v)[0] - friction_excess(pb, u - v)[0]) / 2.0
+        assert float(grad @ v) == pytest.approx(fd, rel=1e-5, abs=1e-12 * abs(c))
+
+
+def test_friction_excess_makes_an_elastic_excursion_dissipate_nothing():
+    """The dissipation constraint's interface form ΔG = ½(f_I(u₀)·u₁ − f_I(u₁)·u₀) takes the
+    stored energy to be the secant one. Friction's stick springs, anchored away from zero slip,
+    store ½ d |t_f|²/α_T instead: an excursion on which nothing damages and nothing slides
+    'dissipates' under ΔG alone. ΔG + Δc (friction_excess) is the trapezoidal work less the
+    change of the stored energy: zero to round-off for these affine springs (the independent
+    reference: an elastic excursion dissipates nothing)."""
+    from layershell.solver.arclength import friction_excess, interface_forces
+
+    pb, blk, ur = _friction_state(cap=1e9)  # every friction point sticks
+    blk.d_old = np.full_like(blk.d_old, 0.95)  # no point's damage grows (secant unloading)
+    u0 = pb.op.T @ ur
+    u1 = 1.1 * u0  # scaled: no point changes from tension to compression
+    for u in (u0, u1):
+        assert np.all(blk.point_state(u)[2] == blk.d_old)
+        assert np.all(blk.contact.slip_ratio(u) < 1)
+    f0, f1 = interface_forces(pb, u0)[0], interface_forces(pb, u1)[0]
+    dG = 0.5 * (float(f0 @ u1) - float(f1 @ u0))
+    dc = friction_excess(pb, u1)[0] - friction_excess(pb, u0)[0]
+    work = 0.5 * float((f0 + f1) @ (u1 - u0))
+    assert abs(dG) > 1e-3 * abs(work)  # the secant form alone books a dissipation
+    assert abs(dG + dc) < 1e-9 * abs(work)

@@ -717,7 +717,8 @@ def _path_stand_ins(monkeypatch, al, **patches) -> None:
     common = {"check_path": lambda p, ps: None, "interface_form": lambda p: False,
               "prescribed_direction": lambda p: None, "dissipation_so_far": lambda p: 0.0,
               "dissipation_increment": lambda *a: 0.0, "conjugates": lambda p, u: (0.0, 0.0),
-              "check_stabilised_step": lambda *a: None, "active_set_blocks": lambda p: ([], False)}
+              "check_stabilised_step": lambda *a: None, "active_set_blocks": lambda p: ([], False),
+              "friction_excess": lambda p, u, gradient=False: (0.0, None)}
     for name, value in {**common, **patches}.items():
         monkeypatch.setattr(al, name, value)
 
@@ -1044,7 +1045,8 @@ def test_the_path_state_survives_a_checkpoint_whole():
 
     st = al.PathState(mode="arc", size=2e-4, arc_length=3e-4, du_prev=np.arange(3.0), lam_peak=2.5,
                       dissipated=0.7, finished=True, arc_length0=1e-2, changed=True,
-                      lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc")
+                      lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc",
+                      dissipation_max=0.3, recent_dissipation=[(1e-2, 8), (1.5e-2, 8)])
     assert all(getattr(st, f.name) != getattr(al.PathState(), f.name) for f in fields(st)
                if f.name != "du_prev")
     back = al.PathState.from_arrays(st.arrays())

@@ -703,6 +703,37 @@ class CohesiveBlock:
         K = np.matmul(c.transpose(0, 2, 1), cM).reshape(ne, 3 * nk, 3 * nk)
         return f, K
 
+    def friction_excess(self, u_full: np.ndarray, gradient: bool = False) -> tuple[float, np.ndarray | None]:
+        """c = ½ Σ_q w d t_f·(P δ − t_f/α_T): what the secant energy ½ f·u of the friction on the
+        damaged share counts beyond its stored energy, and (``gradient``) ∂c/∂u per element
+        (e, 3 k); (0, None) where no friction acts.
+
+        The friction's stick spring holds t_f = α_T (P δ − g_p) from its anchor g_p (sliding: the
+        return-mapped anchor P δ − t_f/α_T), so it stores ½ d |t_f|²/α_T, not the ½ d t_f·δ of the
+        secant form that the dissipation constraint assumes (Gutiérrez 2004: stored energy ½ uᵀf).
+        Their difference is c; the dissipation of an increment is the constraint's ΔG + Δc
+        (solver/arclength.py, :func:`~layershell.solver.arclength.friction_excess`). Without it a
+        sticking point that unloads towards its anchor counts the fall of its c as dissipated,
+        and the constraint is met with no damage. With a = P δ − t_f/α_T and D_f = ∂t_f/∂δ:
+        ∂c/∂δ = ½ [d (D_fᵀ a + (P − D_f/α_T)ᵀ t_f) + (t_f·a) ∂d/∂δ]."""
+        cb = self.contact
+        if cb.cap is None or not np.any(cb.cap > 0):
+            return 0.0, None
+        delta, _, d, _, dd = self.point_state(u_full, with_dd=True)
+        tf, Df = cb.friction_traction(u_full, delta)
+        P = cb.projector()
+        aT = cb._penalty()  # a number or (e, q, 1)
+        a = np.einsum("eqij,eqj->eqi", P, delta) - tf / aT
+        ta = np.einsum("eqi,eqi->eq", tf, a)
+        c = 0.5 * float((cb.w * d * ta).sum())
+        if not gradient:
+            return c, None
+        aT4 = aT[..., None] if np.ndim(aT) else aT
+        G = 0.5 * (d[..., None] * (np.einsum("eqji,eqj->eqi", Df, a) + np.einsum("eqji,eqj->eqi", P - Df / aT4, tf))
+                   + ta[..., None] * dd)
+        ne, _, nk = cb.c.shape
+        return c, np.matmul(cb.c.transpose(0, 2, 1), cb.w[..., None] * G).reshape(ne, 3 * nk)
+
     def elastic_energy(self, u_full: np.ndarray) -> float:
         """Stored energy of the cohesive springs ½K|δ|² - ½dK|<δ_n>n + δ_s|² integrated."""
         delta, _, d, _ = self.point_state(u_full)

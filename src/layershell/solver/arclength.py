@@ -112,13 +112,19 @@ class PathState:
     # control (size_insensitive)
     recent: list = field(default_factory=list)
     recent_mode: str = ""
+    # where friction acts on a damaged share: the largest dissipation-controlled increment Δτ so
+    # far and the last ARC_WINDOW (Δτ, iterations) under that constraint (size_insensitive)
+    dissipation_max: float = 0.0
+    recent_dissipation: list = field(default_factory=list)
 
     def arrays(self) -> dict[str, np.ndarray]:
         out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
                "path.arc_length": np.array(self.arc_length), "path.lam_peak": np.array(self.lam_peak),
                "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
                "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed),
-               "path.lam_damaged": np.array(self.lam_damaged)}
+               "path.lam_damaged": np.array(self.lam_damaged),
+               "path.dissipation_max": np.array(self.dissipation_max),
+               "path.recent_dissipation": np.array(self.recent_dissipation, float).reshape(-1, 2)}
         if self.du_prev is not None:
             out["path.du_prev"] = self.du_prev.copy()
         if self.recent:
@@ -135,7 +141,9 @@ class PathState:
                    float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
                    float(a["path.arc_length0"]), bool(a["path.changed"]),
                    float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan,
-                   *_recent_from_arrays(a))
+                   *_recent_from_arrays(a), float(a.get("path.dissipation_max", 0.0)),
+                   [(float(x), int(n)) for x, n in np.asarray(a.get("path.recent_dissipation", np.zeros((0, 2)))
+                                                             ).reshape(-1, 2)])
 
 
 def _recent_from_arrays(a: dict[str, np.ndarray]) -> tuple[list, str]:
@@ -284,23 +292,47 @@ def energy_control(b0: tuple | None, b1: tuple | None, tolerance: float) -> floa
 
 
 def dissipation_increment(problem: Problem, u0: np.ndarray, lam0: float, du: np.ndarray, dlam: float,
-                          f_itf0: np.ndarray | None = None, reactions: tuple[float, float] | None = None) -> float:
+                          f_itf0: np.ndarray | None = None, reactions: tuple[float, float] | None = None,
+                          friction: tuple[float, float] | None = None) -> float:
     """ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀): energy dissipated by secant-unloading damage in the increment
     (Gutiérrez 2004, eq. (19); Verhoosel et al. 2009, eq. (20)); where λ scales prescribed
     displacements g, their reaction R = gᵀf_int adds ½(R₀ Δλ − λ₀ ΔR) (the same derivation with λ
     as the displacement and R as the force: external work ½(R₀ + R₁)Δλ less the change of the
     stored ½ λ R; :func:`conjugates`; ``reactions``: (R₀, R₁) where known). With ``f_itf0`` (the
     interface forces at u₀, :func:`interface_form`) the interface form ½(f_I(u₀)·u − f_I(u)·u₀)
-    instead."""
+    instead. ``friction``: (c₀, c₁) of :func:`friction_excess` at the start and the end, whose
+    difference the friction's stick springs add (they do not store the secant energy)."""
+    extra = friction[1] - friction[0] if friction is not None else 0.0
     if f_itf0 is not None:
         f1, _ = interface_forces(problem, u0 + du)
-        return 0.5 * (float(f_itf0 @ (u0 + du)) - float(f1 @ u0))
+        return 0.5 * (float(f_itf0 @ (u0 + du)) - float(f1 @ u0)) + extra
     F = problem.F_scaled
     dG = 0.5 * (lam0 * float(F @ du) - dlam * float(F @ u0))
     if prescribed_direction(problem) is not None:
         R0, R1 = reactions if reactions is not None else (conjugates(problem, u0)[1], conjugates(problem, u0 + du)[1])
         dG += 0.5 * (R0 * dlam - lam0 * (R1 - R0))
-    return dG
+    return dG + extra
+
+
+def friction_excess(problem: Problem, u: np.ndarray, gradient: bool = False) -> tuple[float, np.ndarray | None]:
+    """c(u): the secant energy ½ uᵀf that the friction on the damaged share of the cohesive
+    interfaces counts beyond what its stick springs store
+    (:meth:`~layershell.cohesive.CohesiveBlock.friction_excess`), and (``gradient``) ∂c/∂u in
+    the full space (zeros where no friction acts). Both forms of the dissipation constraint take
+    the stored energy to be the secant one; the dissipation of an increment is ΔG + c(u) − c(u₀).
+    Without Δc the constraint was met by friction alone: the lap shear with stiff friction
+    (alpha_T = 1e6) at a tenth of the example's arc length had 264 of its increments refused as
+    friction's (FRICTION_REFUSED) and stopped on its plateau, 1.3 % below its peak, at λ = 1.00014;
+    with it 13, and the path goes on (tests/test_lapshear.py)."""
+    c, grad = 0.0, (np.zeros(problem.dm.n_full) if gradient else None)
+    for b in problem.assembler.extra:
+        if not hasattr(b, "friction_excess"):
+            continue
+        cb, ge = b.friction_excess(u, gradient)
+        c += cb
+        if gradient and ge is not None:
+            grad += np.bincount(b.dofs.ravel(), weights=np.asarray(ge).ravel(), minlength=problem.dm.n_full)
+    return c, grad
 
 
 def interface_form(problem: Problem) -> bool:
@@ -367,7 +399,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     and the same increment iterated on, at most ``max_active_set_loops`` times. A frozen opening
     point that an iterate closes leaves the sets (:func:`_release_closed`). ``f_itf0``: the
     interface forces at u0 where the dissipation is measured at the interfaces
-    (:func:`interface_form`)."""
+    (:func:`interface_form`). Where friction acts on a damaged share the dissipation
+    constraint adds the change of :func:`friction_excess`."""
     op, asm = problem.op, problem.assembler
     blocks = _frozen_blocks(problem)
     loop = ActiveSetLoop(blocks, True)
@@ -382,6 +415,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     qq = float(q @ q)
     solver = problem.linear_solver(s.backend, s.reuse_factorization)
     att = Attempt(False, u0, lam0, 0)
+    fric_c0 = friction_excess(problem, u0)[0] if mode == "dissipation" and _friction_acts(problem) else None
     try:
         _, Kr = asm.evaluate_reduced(u0, op, forces=False)
         dut = problem.solve_tangent(Kr, q, s.backend, s.reuse_factorization)  # at the committed state
@@ -400,6 +434,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     elif f_itf0 is not None:  # interface form (interface_form): ΔG ≈ ½(f_I(u₀) − K_Iᵀu₀)·Δu
         _, kv = interface_forces(problem, u0, u0)
         a1, a2 = 0.5 * float(f_itf0 @ dUt), 0.5 * float(kv @ dUt)
+        if fric_c0 is not None:  # + Δc ≈ ∂c/∂u·Δu
+            a1 += float(friction_excess(problem, u0, True)[1] @ dUt)
         if abs(a1 - a2) <= 1e-6 * (abs(a1) + abs(a2)):
             att.message = "no dissipation in the predictor direction"
             return _unfrozen(att, blocks)
@@ -407,6 +443,8 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     else:
         F = problem.F_scaled
         terms = [lam0 * float(F @ dUt), -float(F @ u0)]
+        if fric_c0 is not None:  # + Δc ≈ ∂c/∂u·Δu (terms are halved below)
+            terms.append(2.0 * float(friction_excess(problem, u0, True)[1] @ dUt))
         if g is not None:  # ½(R₀ Δλ − λ₀ ΔR), ΔR ≈ (K g)·Δu (dissipation_increment)
             terms += [R0, -lam0 * float((F - rate0) @ dUt)]
         den = 0.5 * sum(terms)
@@ -429,7 +467,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         dur, dlam, ok = _constrained_iterations(problem, att, u0, lam0, size, mode, dur, dlam, s, ps, lam_ref,
                                                 min(s.max_iterations, left),
                                                 stagnation_window(s, blocks), f_itf0,
-                                                early=early, at_start=(q, R0))
+                                                early=early, at_start=(q, R0), fric_c0=fric_c0)
         if (not ok and refreeze > 0 and att.best is not None and att.iterations < s.max_contact_iterations
                 and any(b.set_changed(att.best[1]) for b in blocks)):
             # as newton(): the frozen problem has no solution near this increment (its path turns
@@ -467,13 +505,15 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
                             dur: np.ndarray, dlam: float, s: NewtonSettings, ps: PathSettings, lam_ref: float,
                             max_iterations: int, stagnation: int = 0,
                             f_itf0: np.ndarray | None = None, early: list | None = None, *,
-                            at_start: tuple[np.ndarray, float]) -> tuple[np.ndarray, float, bool]:
+                            at_start: tuple[np.ndarray, float],
+                            fric_c0: float | None = None) -> tuple[np.ndarray, float, bool]:
     """Newton iterations on equilibrium and the constraint from the increment (``dur``, ``dlam``);
     updates ``att`` (state, iterations, residuals, message); returns the increment and whether
     it converged. ``stagnation``: give up after that many iterations in a row without progress
     (:func:`~layershell.solver.newton.stagnates`; used with frozen cohesive sets). ``at_start``: the
     reduced load column q and the reaction R (0 without prescribed displacements) at u0, as
-    :func:`arc_attempt` has them from the committed state."""
+    :func:`arc_attempt` has them from the committed state. ``fric_c0``: :func:`friction_excess` at
+    u0, where friction acts (the dissipation constraint adds c(u) − c(u0), linearised)."""
     op, asm = problem.op, problem.assembler
     g = prescribed_direction(problem)  # λ scales prescribed displacements: q = Tᵀ(F̂ − K g) per iteration
     q, R0 = at_start
@@ -559,6 +599,9 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             fI, kv = interface_forces(problem, u, u0)
             gc = 0.5 * (float(f_itf0 @ u) - float(fI @ u0)) - size
             c = 0.5 * (f_itf0 - kv)
+            if fric_c0 is not None:  # + c(u) − c(u₀), linearised with ∂c/∂u
+                cf, gf = friction_excess(problem, u, True)
+                gc, c = gc + cf - fric_c0, c + gf
             cA, cB = float(c @ op.expand(a)), float(c @ (op.expand(b) + (g if g is not None else 0.0)))
             if cB == 0.0:
                 att.message = "the dissipation constraint does not depend on λ here"
@@ -574,6 +617,10 @@ def _constrained_iterations(problem: Problem, att: Attempt, u0: np.ndarray, lam0
             Fu0, Fdu = float(F @ u0), float(F @ dU)
             gc = 0.5 * (lam0 * (Fdu + Fa) - dlam * Fu0) - size
             dg = 0.5 * (lam0 * Fb - Fu0)
+            if fric_c0 is not None:  # + c(u) − c(u₀), linearised with ∂c/∂u
+                cf, gf = friction_excess(problem, u, True)
+                gc += cf - fric_c0 + float(gf @ A)
+                dg += float(gf @ B)
             if g is not None:  # + ½(R₀ Δλ − λ₀ ΔR), R = gᵀf_int linearised with K g = F̂ − rate
                 kg = F - rate
                 gc += 0.5 * (R0 * dlam - lam0 * (float(g @ f) - R0)) - 0.5 * lam0 * float(kg @ A)
@@ -752,6 +799,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         warns: list[str] = []
         size0 = st.size
         f_itf0 = interface_forces(problem, u)[0] if itf_form else None  # the start's (committed) state
+        # friction on a damaged share (its limits change at commits only): c of friction_excess at
+        # the start, and at the end of the increment before its commit moves anchors and limits
+        friction = arc and _friction_acts(problem)
+        fric_c0 = friction_excess(problem, u)[0] if friction else None
+        fric_c1 = fric_c0
         b0 = (balance_terms(problem, u) if arc and ps.energy_tolerance is not None and on_step_end is not None
               else None)  # the ledger at the start (energy_control)
         # the interfaces' ledger at the start (all dissipation, by damage): CONSTRAINT_BOOKED, unloading
@@ -790,6 +842,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             residuals += att.residuals
             ok = att.converged
             msg = att.message
+            if ok and friction:
+                fric_c1 = friction_excess(problem, att.u)[0]
             if ok and on_step_end is not None:
                 a0 = measure(problem) if measure is not None else None
                 while on_step_end(problem, att.u, att.lam):
@@ -813,6 +867,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     if not att.converged:
                         ok, msg = False, att.message
                         break
+                    if friction:
+                        fric_c1 = friction_excess(problem, att.u)[0]
             if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
                     and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
                 ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
@@ -980,7 +1036,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         if displacement_path and reaction is None:
             reaction = conjugates(problem, u)[1]  # R at the start (first increment, restart)
         dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0,
-                                   None if conj is None else (reaction, conj[1]))
+                                   None if conj is None else (reaction, conj[1]),
+                                   (fric_c0, fric_c1) if friction else None)
         st.dissipated += dG
         # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
         damage = ledger_booked(problem)[1] if ledger0 is not None and problem.interfaces.cohesive() else None
@@ -997,6 +1054,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         fac = min(2.0, max(0.5, ps.target_iterations / its))
         if cuts:
             fac = min(fac, 1.0)  # no growth right after a cut
+        elif (st.mode == "dissipation" and friction and used < INSENSITIVE_BELOW * st.dissipation_max
+              and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
+            # as below, where friction acts: each commit moves the friction's anchors and limits,
+            # and the count no longer falls with the size (the lap shear with alpha_T = 1e5: Δτ held
+            # at 0.2-0.7, 1/100 of its largest, by 8 iterations each, 703 instead of 142 increments)
+            fac = max(fac, INSENSITIVE_GROWTH)
         elif (st.mode in ("load", "arc")
               # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
               # increments at any size (the slab on 16 × 12 took 6-10 iterations at Δλ = 0.4-5
@@ -1008,6 +1071,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         if st.mode in ("load", "arc"):
             st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
             st.recent_mode = st.mode
+        elif friction:
+            st.recent_dissipation = (st.recent_dissipation + [(used, its)])[-ARC_WINDOW:]
+            st.dissipation_max = max(st.dissipation_max, used)
         if e_rel > 0.5:
             fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
         if st.mode == "load":
@@ -1098,7 +1164,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
                          start_inertia(problem))
         res.state = replace(st, du_prev=None if st.du_prev is None else st.du_prev.copy(),
-                            recent=list(st.recent))  # (a copy of every field: lam_damaged was
+                            recent=list(st.recent), recent_dissipation=list(st.recent_dissipation))  # (a copy of every field: lam_damaged was
         # left out of the field-by-field copy before, and a restart lost it)
         res.warnings = warns
         res.dissipation = dG
