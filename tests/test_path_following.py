@@ -1108,3 +1108,41 @@ def test_the_arc_length_takes_over_a_failed_dissipation_increment_from_a_length_
         list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
                            on_step_end=lambda problem, u, lam: False))
     assert ("arc", pytest.approx(0.04)) in tried and all(size <= 0.04 for m, size in tried if m == "arc")
+
+
+def test_the_arc_length_goes_back_to_an_increment_from_a_length_it_can_cut(monkeypatch):
+    """An arc-length increment that fails hands the increment to the dissipation constraint;
+    where that fails three times, the arc length takes it back, cut - from at least
+    arc_length_restart (1/16 of its first length), as where the dissipation constraint fails
+    through all its cuts (test above). From the length of the last accepted increment, the
+    smallest after a crawl of dissipation increments of Δτ ~ 10⁻⁸, it could not be cut and the
+    run stopped: the cohesive slab on 8 × 6 at 258.63 kN/m² on its plateau (restarted there with
+    this rule it goes on). Stand-ins: arc-length increments that converge from a length of 0.03
+    on, dissipation-controlled ones that never converge, a rescue that never converges."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonResult, NewtonSettings
+
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        tried.append((mode, size))
+        ok = mode == "arc" and size >= 0.03
+        return al.Attempt(ok, u + 1e-3, lam + 0.01, 3, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
+
+    def never(problem, u, lam, s):
+        return u, NewtonResult(False, 2, [1.0], message="stand-in: diverged")
+
+    booked = {"damage": 0.0}
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0, newton=never,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]),
+                    _first_dissipation=lambda p, u, lam, dl: 1e-6)
+    pb = _stand_in_problem(booked)
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
+    # the last accepted increment was as short as the arc length may be (1/1000 of the first)
+    st0 = al.PathState(mode="arc", size=1e-3, arc_length=1e-3, lam_peak=0.6, arc_length0=1.0)
+    steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0,
+                               on_step_end=lambda problem, u, lam: False))
+    assert [s.load_factor for s in steps] == pytest.approx([0.51])
+    assert [m for m, _ in tried] == ["arc"] + ["dissipation"] * 4 + ["arc"]
+    assert tried[-1][1] == pytest.approx(al.ARC_AFTER_DISSIPATION / 2)  # taken back, cut once

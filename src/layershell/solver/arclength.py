@@ -963,7 +963,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 st.size = _first_dissipation(problem, u, lam, st.size)
                 continue
             if st.mode == "dissipation" and tried_dissipation and cuts >= 3:
-                st.mode, st.size = "arc", st.arc_length  # it did not help: the arc length again, cut
+                # it did not help: the arc length again, cut - from at least arc_length_restart, not
+                # from the length of the last accepted increment: the cohesive slab on 8 × 6 stopped
+                # so at 258.63 kN/m² on its plateau, where dissipation increments of Δτ ~ 10⁻⁸ had
+                # left the arc length at its smallest, one try (docs/performance.md)
+                st.mode, st.size = "arc", min(arc_length_restart(st.arc_length, st.arc_length0), dl_max)
             cuts += 1
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
