@@ -1062,6 +1062,29 @@ def test_the_path_state_survives_a_checkpoint_whole():
     assert back.recent == [(0.01, 6)] and back.recent_mode == "load"
 
 
+def _arc_from_a_length(monkeypatch, al, least: float, **patches):
+    """Stand-ins for the restart-length tests: arc-length increments that converge from a length
+    of ``least`` on (λ + 0.01), dissipation-controlled ones that never converge, a Newton solve
+    (the load-controlled rescue) that never converges. Returns the list of tried (mode, size)
+    and the stand-in problem."""
+    from layershell.solver.newton import NewtonResult
+
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, *a, **k):
+        tried.append((mode, size))
+        ok = mode == "arc" and size >= least
+        return al.Attempt(ok, u + 1e-3, lam + 0.01, 3, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
+
+    def never(problem, u, lam, s):
+        return u, NewtonResult(False, 2, [1.0], message="stand-in: diverged")
+
+    booked = {"damage": 0.0}
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0, newton=never,
+                    ledger_booked=lambda p: (booked["damage"], booked["damage"]), **patches)
+    return tried, _stand_in_problem(booked)
+
+
 def test_the_arc_length_takes_over_a_failed_dissipation_increment_from_a_length_it_can_cut(monkeypatch):
     """Where the dissipation constraint fails at all its sizes, the arc length takes the increment
     over - from at least ARC_AFTER_DISSIPATION of its first length, not from the length of the last
@@ -1072,22 +1095,9 @@ def test_the_arc_length_takes_over_a_failed_dissipation_increment_from_a_length_
     converge, arc-length increments that converge from a length of 0.05 on (λ + 0.01), a Newton
     solve (the load-controlled rescue) that never converges."""
     from layershell.solver import arclength as al
-    from layershell.solver.newton import ConvergenceError, NewtonResult, NewtonSettings
+    from layershell.solver.newton import ConvergenceError, NewtonSettings
 
-    tried = []
-
-    def attempt(problem, u, lam, size, mode, *a, **k):
-        tried.append((mode, size))
-        ok = mode == "arc" and size >= 0.05
-        return al.Attempt(ok, u + 1e-3, lam + 0.01, 3, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
-
-    def never(problem, u, lam, s):
-        return u, NewtonResult(False, 2, [1.0], message="stand-in: diverged")
-
-    booked = {"damage": 0.0}
-    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0, newton=never,
-                    ledger_booked=lambda p: (booked["damage"], booked["damage"]))
-    pb = _stand_in_problem(booked)
+    tried, pb = _arc_from_a_length(monkeypatch, al, 0.05)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
                          jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
     # the last accepted increment was as short as the arc length may be (1/1000 of the first)
@@ -1120,23 +1130,9 @@ def test_the_arc_length_goes_back_to_an_increment_from_a_length_it_can_cut(monke
     this rule it goes on). Stand-ins: arc-length increments that converge from a length of 0.03
     on, dissipation-controlled ones that never converge, a rescue that never converges."""
     from layershell.solver import arclength as al
-    from layershell.solver.newton import NewtonResult, NewtonSettings
+    from layershell.solver.newton import NewtonSettings
 
-    tried = []
-
-    def attempt(problem, u, lam, size, mode, *a, **k):
-        tried.append((mode, size))
-        ok = mode == "arc" and size >= 0.03
-        return al.Attempt(ok, u + 1e-3, lam + 0.01, 3, [1e-10 if ok else 1.0], message="" if ok else "stand-in")
-
-    def never(problem, u, lam, s):
-        return u, NewtonResult(False, 2, [1.0], message="stand-in: diverged")
-
-    booked = {"damage": 0.0}
-    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0, newton=never,
-                    ledger_booked=lambda p: (booked["damage"], booked["damage"]),
-                    _first_dissipation=lambda p, u, lam, dl: 1e-6)
-    pb = _stand_in_problem(booked)
+    tried, pb = _arc_from_a_length(monkeypatch, al, 0.03, _first_dissipation=lambda p, u, lam, dl: 1e-6)
     ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0,
                          jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=1)
     # the last accepted increment was as short as the arc length may be (1/1000 of the first)
