@@ -19,11 +19,14 @@ demo: $(STAMP)
 	@echo "    source $(VENV)/bin/activate"
 	@echo "(or call $(BIN)/layershell directly; 'deactivate' leaves the environment)"
 
+# extra pytest arguments, e.g. `make test-slow PYTEST_ARGS="--time-budget 3600"` (.ci/run)
+PYTEST_ARGS ?=
+
 test: $(STAMP)
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS)
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow
+	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)
 
 test-all: $(STAMP)
 	$(BIN)/python -m pytest

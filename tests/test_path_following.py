@@ -1109,6 +1109,7 @@ def test_the_arc_length_takes_over_a_failed_dissipation_increment_from_a_length_
     assert modes == ["dissipation"] * 3 + ["arc"]  # three dissipation sizes (max_cuts = 2), then the arc length
     assert tried[-1][1] == pytest.approx(al.ARC_AFTER_DISSIPATION)
     assert al.arc_length_restart(0.2, 1.0) == 0.2  # a longer last increment: its own length
+    assert al.arc_length_restart(1e-3, 1.0, 0.01) == 0.01  # never above a user's arc_length_max
     # from a length below 0.05 the arc length's halvings cannot reach one that converges: the run
     # stops (the rescue by load control fails as well) after trying the arc length at its restart length
     tried[:] = []

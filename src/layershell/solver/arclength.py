@@ -967,7 +967,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # from the length of the last accepted increment: the cohesive slab on 8 × 6 stopped
                 # so at 258.63 kN/m² on its plateau, where dissipation increments of Δτ ~ 10⁻⁸ had
                 # left the arc length at its smallest, one try (docs/performance.md)
-                st.mode, st.size = "arc", min(arc_length_restart(st.arc_length, st.arc_length0), dl_max)
+                st.mode, st.size = "arc", arc_length_restart(st.arc_length, st.arc_length0, dl_max)
             cuts += 1
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
@@ -1011,7 +1011,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     # snap-back the previous direction follows elastic unloading down to λ = 0.
                     # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
                     st.mode, st.changed = "arc", True
-                    st.size = min(arc_length_restart(st.arc_length, st.arc_length0), dl_max)
+                    st.size = arc_length_restart(st.arc_length, st.arc_length0, dl_max)
                     cuts, tried_dissipation = 0, True
                     continue
                 if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
@@ -1315,7 +1315,7 @@ ARC_WINDOW = 2
 ARC_AFTER_DISSIPATION = 1.0 / 16.0
 
 
-def arc_length_restart(arc_length: float, arc_length0: float) -> float:
+def arc_length_restart(arc_length: float, arc_length0: float, arc_length_max: float = np.inf) -> float:
     """The length from which the arc length takes over an increment that the dissipation
     constraint could not make at any of its sizes: the length of the last accepted increment,
     but at least ARC_AFTER_DISSIPATION × the first arc length. After a crawl of short dissipation
@@ -1324,8 +1324,9 @@ def arc_length_restart(arc_length: float, arc_length0: float) -> float:
     by arc length on 8 × 6 stopped so at 266.28 kN/m² on its snap-back (Δτ down to 2·10⁻⁸ failed,
     then the arc length at 4.5·10⁻⁶ of the first 4.5·10⁻³), where arc lengths of 3·10⁻⁵ to 10⁻³
     from the same state converge in 10-32 iterations (either predictor direction). From the
-    longer start the usual halvings still reach the smallest length."""
-    return max(arc_length, ARC_AFTER_DISSIPATION * arc_length0)
+    longer start the usual halvings still reach the smallest length. Never above
+    ``arc_length_max`` (a user's maximum below 1/16 of the first length)."""
+    return min(max(arc_length, ARC_AFTER_DISSIPATION * arc_length0), arc_length_max)
 
 
 #: a stalled path (:func:`stalled`) ends as complete failure only below this fraction of its peak
