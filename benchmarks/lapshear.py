@@ -4,6 +4,13 @@ the table in docs/user-guide.md. Uses the path tracer of tests/test_lapshear.py.
 
     PYTHONPATH=src python benchmarks/lapshear.py            # bond lengths, 10 mm elements
     PYTHONPATH=src python benchmarks/lapshear.py --mesh     # L = 100 mm on 20, 10, 5, 2.5 mm
+    PYTHONPATH=src python benchmarks/lapshear.py --friction # stiff stick penalties, short arc lengths
+
+``--friction``: the example's bond with friction (μ0 = 0.95) and a stick penalty alpha_T of 1e5 or
+1e6 N/mm³, at the example's arc length and at a half, a quarter and a tenth of it (the
+``arc_fraction`` of the test's trace), run to 3 % below the peak: increments, the peak above
+P_u (the friction's share, 0.35 % rigid-plastic) and the time (docs/performance.md, "Where
+friction sets the iteration count").
 """
 from __future__ import annotations
 
@@ -14,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_lapshear import JOINT, P_U, trace  # noqa: E402
+from test_lapshear import JOINT, L0, P_U, trace  # noqa: E402
 
 
 def row(L: float, h: float) -> str:
@@ -28,7 +35,22 @@ def row(L: float, h: float) -> str:
             f"{time.perf_counter() - t0:.1f} s |")
 
 
+def friction_row(alpha_T: float, fraction: float) -> str:
+    t0 = time.perf_counter()
+    o = trace(extra={"mu0 = 0.0": f"mu0 = 0.95\nalpha_T = {alpha_T!r}", "max_steps = 300": "max_steps = 3000"},
+              arc_fraction=fraction)
+    end = f"{o['P'][-1] / o['peak']:.3f} of the peak" + (" (stopped)" if "stopped" in o else "")
+    return (f"| {alpha_T:g} | {fraction:g} | {len(o['P'])} | {100 * (o['peak'] / JOINT.peak_load(L0) - 1):+.3f} % | "
+            f"{end} | {time.perf_counter() - t0:.1f} s |")
+
+
 def main(argv: list[str]) -> None:
+    if "--friction" in argv:
+        print("| alpha_T (N/mm³) | share of the arc length | increments | peak above P_u | end | wall |")
+        print("|---|---|---|---|---|---|")
+        for alpha_T, fraction in ((1e5, 1.0), (1e6, 1.0), (1e5, 0.25), (1e6, 0.25), (1e6, 0.5), (1e5, 0.1), (1e6, 0.1)):
+            print(friction_row(alpha_T, fraction), flush=True)
+        return
     print("| L (mm) | element (mm) | P_max FE (kN) | closed form (kN) | difference | max |P - P_closed(δ0)| / P_u "
           "| energy balance | steps | wall |")
     print("|---|---|---|---|---|---|---|---|---|")

@@ -1278,7 +1278,7 @@ INSENSITIVE_BELOW = 1.0 / 16.0
 
 #: where friction acts, dissipation-controlled increments grow so below this share of the largest
 #: so far: with 1/16 (as INSENSITIVE_BELOW) the lap shear with alpha_T = 1e6 at a quarter of the arc
-#: length held Δτ at 1/5-1/10 of its largest with 10-12 iterations at any size there, 735
+#: length held Δτ at 1/5-1/20 of its largest with 10-12 iterations at any size there, 735
 #: increments (254 with 1/2; the peaks within 0.03 % of P_u)
 DISSIPATION_INSENSITIVE_BELOW = 0.5
 
