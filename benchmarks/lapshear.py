@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-from test_lapshear import JOINT, L0, P_U, trace  # noqa: E402
+from test_lapshear import JOINT, L0, P_U, trace, trace_with_friction  # noqa: E402
 
 
 def row(L: float, h: float) -> str:
@@ -37,8 +37,7 @@ def row(L: float, h: float) -> str:
 
 def friction_row(alpha_T: float, fraction: float) -> str:
     t0 = time.perf_counter()
-    o = trace(extra={"mu0 = 0.0": f"mu0 = 0.95\nalpha_T = {alpha_T!r}", "max_steps = 300": "max_steps = 3000"},
-              arc_fraction=fraction)
+    o = trace_with_friction(alpha_T, 3000, fraction)
     end = f"{o['P'][-1] / o['peak']:.3f} of the peak" + (" (stopped)" if "stopped" in o else "")
     return (f"| {alpha_T:g} | {fraction:g} | {len(o['P'])} | {100 * (o['peak'] / JOINT.peak_load(L0) - 1):+.3f} % | "
             f"{end} | {time.perf_counter() - t0:.1f} s |")

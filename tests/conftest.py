@@ -1,3 +1,5 @@
+import time
+
 import numpy as np
 import pytest
 
@@ -30,6 +32,8 @@ def flat_distorted_element(rng, distort=0.15):
 # summary - the tests that ran are not lost with a killed job (.ci/run).
 
 _BUDGET_REASON = "the session's --time-budget was spent before this test started"
+_START = pytest.StashKey[float]()
+_OVER_BUDGET = pytest.StashKey[list]()
 
 
 def pytest_addoption(parser):
@@ -39,23 +43,19 @@ def pytest_addoption(parser):
 
 
 def pytest_configure(config):
-    import time
-
-    config._layershell_start = time.monotonic()
-    config._layershell_over_budget = []
+    config.stash[_START] = time.monotonic()
+    config.stash[_OVER_BUDGET] = []
 
 
 def pytest_runtest_setup(item):
-    import time
-
     budget = item.config.getoption("--time-budget")
-    if budget is not None and time.monotonic() - item.config._layershell_start > budget:
-        item.config._layershell_over_budget.append(item.nodeid)
+    if budget is not None and time.monotonic() - item.config.stash[_START] > budget:
+        item.config.stash[_OVER_BUDGET].append(item.nodeid)
         pytest.skip(f"{_BUDGET_REASON} ({budget:.0f} s)")
 
 
 def pytest_terminal_summary(terminalreporter, config):
-    skipped = getattr(config, "_layershell_over_budget", [])
+    skipped = config.stash[_OVER_BUDGET]
     if skipped:
         terminalreporter.write_sep("=", f"{len(skipped)} tests not run: --time-budget "
                                         f"{config.getoption('--time-budget'):.0f} s spent", yellow=True)

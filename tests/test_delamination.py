@@ -654,8 +654,8 @@ def test_refined_thesis_plate_with_the_contact_at_the_nodes(monkeypatch):
     monkeypatch.setattr(newton, "settle", _no_settling)
     gauss = run_example("cantilever_plate_slip", {**REFINED, **GAUSS_CONTACT})
     assert not gauss.converged and 'rule = "lobatto"' in gauss.message
-    # it stops at a re-solution after a cascade: at λ = 0.375 with the default threads, at 0.5 with
-    # one MKL/OpenMP thread (round-off decides which set cycles first, as in the test above)
+    # it stops at a re-solution after a cascade: at λ = 0.375 with the default threads, at 0.5 in the
+    # slow suite on one MKL/OpenMP thread (round-off decides which set cycles first, as in the test above)
     assert 0.125 < gauss.failure["load_factor"] < 1.0
     assert gauss.summary["steps"][-1]["load_factor"] == pytest.approx(gauss.failure["load_factor"] - 1 / 24)
     nodal = run_example("cantilever_plate_slip", {**REFINED, **NODAL_CONTACT})

@@ -385,11 +385,17 @@ def test_friction_with_a_stiff_stick_penalty_passes_the_peak():
     _passes_the_peak_with_the_friction_share(alpha_T=1e5, max_steps=600)
 
 
+def trace_with_friction(alpha_T: float, max_steps: int, arc_fraction: float = 1.0) -> dict:
+    """:func:`trace` of the example with friction (mu0 = 0.95) and a stick penalty ``alpha_T``,
+    at most ``max_steps`` increments (also benchmarks/lapshear.py --friction)."""
+    return trace(extra={"mu0 = 0.0": f"mu0 = 0.95\nalpha_T = {alpha_T!r}", "max_steps = 300": f"max_steps = {max_steps}"},
+                 arc_fraction=arc_fraction)
+
+
 def _passes_the_peak_with_the_friction_share(alpha_T: float, max_steps: int, arc_fraction: float = 1.0) -> None:
     """The lap shear with friction and a stick penalty ``alpha_T`` passes its peak to 3 % below
     it, and its peak lies above the default's (a longer stick range) by less than 0.1 % of P_u."""
-    f = trace(extra={"mu0 = 0.0": f"mu0 = 0.95\nalpha_T = {alpha_T!r}", "max_steps = 300": f"max_steps = {max_steps}"},
-              arc_fraction=arc_fraction)
+    f = trace_with_friction(alpha_T, max_steps, arc_fraction)
     assert "stopped" not in f
     assert f["P"][-1] < 0.97 * max(f["P"])
     stiff = f["peak"] / JOINT.peak_load(L0) - 1
