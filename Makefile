@@ -21,15 +21,25 @@ demo: $(STAMP)
 
 # extra pytest arguments, e.g. `make test-slow PYTEST_ARGS="--time-budget 3600"` (.ci/run)
 PYTEST_ARGS ?=
+# The tests run in parallel (pytest-xdist): JOBS processes, "auto" = one per core, each on one
+# thread, and each test file whole in one process (its shared fixtures run once). `make test JOBS=0`
+# runs them in this process, on the threads the environment gives.
+JOBS ?= auto
+ifeq ($(JOBS),0)
+PYTEST_JOBS :=
+else
+PYTEST_JOBS := OMP_NUM_THREADS=1 MKL_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 NUMBA_NUM_THREADS=1
+PYTEST_JOBS_ARGS := -n $(JOBS) --dist loadfile
+endif
 
 test: $(STAMP)
-	$(BIN)/python -m pytest -m "not slow" $(PYTEST_ARGS)
+	$(PYTEST_JOBS) $(BIN)/python -m pytest -m "not slow" $(PYTEST_JOBS_ARGS) $(PYTEST_ARGS)
 
 test-slow: $(STAMP)
-	$(BIN)/python -m pytest -m slow $(PYTEST_ARGS)
+	$(PYTEST_JOBS) $(BIN)/python -m pytest -m slow $(PYTEST_JOBS_ARGS) $(PYTEST_ARGS)
 
 test-all: $(STAMP)
-	$(BIN)/python -m pytest
+	$(PYTEST_JOBS) $(BIN)/python -m pytest $(PYTEST_JOBS_ARGS) $(PYTEST_ARGS)
 
 clean:
 	rm -rf $(VENV) results build src/*.egg-info

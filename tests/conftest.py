@@ -33,7 +33,6 @@ def flat_distorted_element(rng, distort=0.15):
 
 _BUDGET_REASON = "the session's --time-budget was spent before this test started"
 _START = pytest.StashKey[float]()
-_OVER_BUDGET = pytest.StashKey[list]()
 
 
 def pytest_addoption(parser):
@@ -44,18 +43,19 @@ def pytest_addoption(parser):
 
 def pytest_configure(config):
     config.stash[_START] = time.monotonic()
-    config.stash[_OVER_BUDGET] = []
 
 
 def pytest_runtest_setup(item):
     budget = item.config.getoption("--time-budget")
     if budget is not None and time.monotonic() - item.config.stash[_START] > budget:
-        item.config.stash[_OVER_BUDGET].append(item.nodeid)
         pytest.skip(f"{_BUDGET_REASON} ({budget:.0f} s)")
 
 
 def pytest_terminal_summary(terminalreporter, config):
-    skipped = config.stash[_OVER_BUDGET]
+    # from the skip reports, so that the list is complete when pytest-xdist's worker processes ran the
+    # tests (`make test`): each worker measures the budget from its own start
+    skipped = [r.nodeid for r in terminalreporter.stats.get("skipped", [])
+               if isinstance(r.longrepr, tuple) and _BUDGET_REASON in str(r.longrepr[-1])]
     if skipped:
         terminalreporter.write_sep("=", f"{len(skipped)} tests not run: --time-budget "
                                         f"{config.getoption('--time-budget'):.0f} s spent", yellow=True)
