@@ -1,3 +1,4 @@
+import os
 import time
 
 import numpy as np
@@ -23,6 +24,18 @@ def flat_distorted_element(rng, distort=0.15):
     xi = NODE_XI + distort * rng.standard_normal((9, 2)) * (np.abs(NODE_XI) < 1)
     X = np.stack([2.0 * xi[:, 0] + 0.3 * xi[:, 1], 1.5 * xi[:, 1], 0 * xi[:, 0]], -1)
     return X[None]
+
+
+# --- parallel processes (`make test`: pytest-xdist's -n auto) ----------------------------------------
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_xdist_auto_num_workers(config):
+    """One process per usable core, within the CPU quota and one per 6 GiB (tests/parallel.py)."""
+    if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
+        return None  # xdist's own hook reads it
+    from parallel import this_machine
+
+    return this_machine()
 
 
 # --- a time budget for CI -------------------------------------------------------------------------

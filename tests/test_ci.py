@@ -1,5 +1,6 @@
 """The CI time budget (tests/conftest.py, .ci/run): tests that would start after the budget are
 skipped and listed, the others run; `make` runs the test files in parallel processes on one thread."""
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -55,3 +56,14 @@ def test_make_runs_the_test_files_in_parallel_processes_on_one_thread_each():
                                                       "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"))
             assert threads == parallel and ("--dist loadfile" in line) == parallel, (target, jobs, line)
             assert (f"-n {jobs}" in line) == parallel, line
+
+
+def test_the_parallel_processes_follow_the_cores_the_quota_and_the_memory():
+    from parallel import MEMORY_PER_WORKER, auto_workers, this_machine
+
+    assert auto_workers(2) == 2 and auto_workers(2, None, 24 * 1024**3) == 2
+    assert auto_workers(64, 2.0, 24 * 1024**3) == 2  # a container's quota on a large host
+    assert auto_workers(64, 1.5) == 1 and auto_workers(64, 0.5) == 1
+    assert auto_workers(16, None, 3 * MEMORY_PER_WORKER + 1) == 3  # memory binds
+    assert auto_workers(4, None, 1024**3) == 1
+    assert 1 <= this_machine() <= (os.cpu_count() or 1)
