@@ -28,7 +28,7 @@ def flat_distorted_element(rng, distort=0.15):
 
 # --- parallel processes (`make test`: pytest-xdist's -n auto) ----------------------------------------
 
-@pytest.hookimpl(tryfirst=True)
+@pytest.hookimpl(tryfirst=True, optionalhook=True)  # optional: without pytest-xdist
 def pytest_xdist_auto_num_workers(config):
     """One process per usable core, within the CPU quota and one per 6 GiB (tests/parallel.py)."""
     if os.environ.get("PYTEST_XDIST_AUTO_NUM_WORKERS"):
