@@ -1,6 +1,6 @@
 """How many pytest-xdist processes `make test` starts (``-n auto``; tests/conftest.py): one per
 core this process may use, but no more than the CPU quota of its control group allows, and at
-most one per 6 GiB of memory (a slow test's process has held up to 6.5 GB: the slab on 32 × 24).
+most one per 6 GiB of memory (a worker of the slow suite held 6.5 GB here).
 A container on a large host can see all the host's cores in ``os.cpu_count()`` while its quota and
 memory are those of a small machine; ``PYTEST_XDIST_AUTO_NUM_WORKERS`` overrides all of this."""
 from __future__ import annotations

@@ -45,6 +45,8 @@ def test_make_runs_the_test_files_in_parallel_processes_on_one_thread_each():
     in one process on the environment's threads."""
     import shutil
 
+    from layershell.sweep import THREAD_VARS  # the variables a sweep's worker holds at one thread
+
     if not shutil.which("make"):
         pytest.skip("make is not installed")
     for target in ("test", "test-slow"):
@@ -52,8 +54,7 @@ def test_make_runs_the_test_files_in_parallel_processes_on_one_thread_each():
             dry = subprocess.run(["make", "-n", target, f"JOBS={jobs}"], cwd=ROOT,
                                  capture_output=True, text=True, timeout=60)
             line = [s for s in dry.stdout.splitlines() if "-m pytest" in s][-1]
-            threads = all(f"{v}=1" in line for v in ("OMP_NUM_THREADS", "MKL_NUM_THREADS",
-                                                      "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS"))
+            threads = all(f"{v}=1" in line for v in THREAD_VARS)
             assert threads == parallel and ("--dist loadfile" in line) == parallel, (target, jobs, line)
             assert (f"-n {jobs}" in line) == parallel, line
 

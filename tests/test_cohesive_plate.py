@@ -226,7 +226,7 @@ def test_arc_length_on_the_nonlinear_mitc9_plate_reaches_full_load_on_12_x_12():
 def test_arc_length_on_the_mitc9_plate_with_friction_reaches_full_load_on_12_x_12():
     """The example's plate with its friction, MITC9, 12 × 12, by arc length. Under load control
     this run needs the viscous stabilisation from λ = 0.995, where the TRC flap at the clamp
-    debonds (test above); by arc length it advanced only to λ = 0.569 in 160 increments (27 Nov
+    debonds (``test_mitc9_plate_reaches_full_load_on_12_x_12``); by arc length it advanced only to λ = 0.569 in 160 increments (27 Nov
     2026). Since the friction's stick state in the active-set loop's cycle key, the reversal limit,
     the friction's stored energy in the dissipation constraint and load-controlled stretches on
     rising branches (30 Nov 2026) it reaches λ = 1 (17 increments, 370 iterations, 2 minutes),
