@@ -234,14 +234,68 @@ def _nodal_normals(model) -> np.ndarray:
     return out
 
 
-def _node_points(model, nodes):
-    """An (element, ξ, η) for each node."""
+def _node_points(model, nodes, layer: int | None = None):
+    """An (element, ξ, η) for each node: the element of lowest index that holds the node (and,
+    with ``layer``, that layer; where no element at the node holds it, one without it: see
+    :func:`has_layer`)."""
     el_of = np.full(model.mesh.n_nodes, -1)
     loc_of = np.zeros(model.mesh.n_nodes, np.int64)
     E = model.mesh.elements
-    el_of[E[::-1].ravel()] = np.repeat(np.arange(len(E))[::-1], 9)
-    loc_of[E[::-1].ravel()] = np.tile(np.arange(9), len(E))
+    order = np.arange(len(E))[::-1]
+    if layer is not None:  # the elements with the layer are written last, so they win
+        order = np.concatenate([order[~has_layer(model, order, layer)], order[has_layer(model, order, layer)]])
+    el_of[E[order].ravel()] = np.repeat(order, 9)
+    loc_of[E[order].ravel()] = np.tile(np.arange(9), len(order))
     return el_of[nodes], NODE_XI[loc_of[nodes], 0], NODE_XI[loc_of[nodes], 1]
+
+
+def has_layer(model, elements, layer: int) -> np.ndarray:
+    """Whether each of ``elements`` holds layer ``layer`` (its [[stacks]] entry names it)."""
+    holds = np.array([layer in st for st in model.stacks], bool)
+    return holds[model.element_stack[np.asarray(elements, np.int64)]]
+
+
+def locate_points(model, points, layer: int | None = None, n_candidates: int = 12):
+    """(element, ξ, η, distance, layer present) of the reference-surface point nearest to each of
+    ``points (P, 3)``, all projected at once (Gauss-Newton on the ``n_candidates`` elements with
+    the nearest centres, as :func:`layershell.results.locate`). A point that several elements
+    contain (an element edge or corner) goes to the first of them in order of centre distance,
+    element index on ties; with ``layer``, to the first of those that hold the layer, so a point on
+    the end of a layer reads that layer whatever the mesh numbering; ``present`` is False where
+    none of them holds it."""
+    from scipy.spatial import cKDTree
+
+    from ..element.geometry import surface_points
+
+    P = np.atleast_2d(np.asarray(points, float))
+    mesh = model.mesh
+    centres = mesh.nodes[mesh.elements].mean(1)
+    c = min(n_candidates, mesh.n_elements)
+    _, cand = cKDTree(centres).query(P, k=c)
+    cand = np.sort(np.asarray(cand, np.int64).reshape(len(P), c), axis=1)  # by index, then by centre distance
+    dc = np.linalg.norm(centres[cand] - P[:, None], axis=2)
+    cand = np.take_along_axis(cand, np.argsort(dc, axis=1, kind="stable"), 1)
+    X = mesh.nodes[mesh.elements[cand.ravel()]]  # (P c, 9, 3)
+    target = np.repeat(P, c, axis=0)
+    x = np.zeros((X.shape[0], 2))
+    for _ in range(30):
+        sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+        A = sp.A[:, 0]
+        G = np.einsum("cia,cib->cab", A, A)
+        step = -np.linalg.solve(G, np.einsum("cia,ci->ca", A, sp.X0[:, 0] - target)[..., None])[..., 0]
+        x = np.clip(x + step, -1.0, 1.0)
+        if np.abs(step).max() < 1e-13:
+            break
+    sp = surface_points(X, x[:, :1], x[:, 1:], per_element=True)
+    dist = np.linalg.norm(sp.X0[:, 0] - target, axis=1).reshape(len(P), c)
+    x = x.reshape(len(P), c, 2)
+    contains = dist <= dist.min(1, keepdims=True) + 1e-9 * mesh.size()
+    present = np.ones_like(contains) if layer is None else has_layer(model, cand, layer)
+    wanted = contains & present
+    present_any = wanted.any(1)
+    pick = np.where(present_any, np.argmax(wanted, 1), np.argmax(contains, 1))
+    rows = np.arange(len(P))
+    return cand[rows, pick], x[rows, pick, 0], x[rows, pick, 1], dist[rows, pick], present_any
 
 
 def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
@@ -286,15 +340,21 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
             th, local = np.zeros(1), True
         if pd.quantity == "displacement":
             nodes = node_selection(model.mesh, pd, f)
-            el, xi, eta = _node_points(model, nodes)
+            el, xi, eta = _node_points(model, nodes, k)
+            absent = np.zeros(el.size, bool) if k is None else ~has_layer(model, el, k)
+            if absent.any():
+                given = "where" if pd.where is not None else "set" if pd.set is not None else "point"
+                _absent_layer(model, f, k, el[absent][0], model.mesh.nodes[nodes[absent][0]], given)
         else:
             if pd.point is None:
                 raise InputError(f"'{f}.point': a {pd.quantity} probe needs a point on the reference surface")
-            e, x, y, dist = locate(model, pd.point)
-            if dist > 1e-3 * model.mesh.size():
-                raise InputError(f"'{f}.point': {pd.point} is {dist:.4g} away from the reference surface; "
+            e, x, y, dist, present = locate_points(model, [pd.point], k)
+            if dist[0] > 1e-3 * model.mesh.size():
+                raise InputError(f"'{f}.point': {pd.point} is {dist[0]:.4g} away from the reference surface; "
                                  "give a point on the reference surface (Θ³ = 0) and the height in theta3")
-            el, xi, eta = np.array([e]), np.array([x]), np.array([y])
+            if not present[0]:
+                _absent_layer(model, f, k, e[0], pd.point, "point")
+            el, xi, eta = e, x, y
         if not local:
             _check_heights(model, f, el, xi, eta, th, k)
         P = el.size
@@ -305,6 +365,17 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         out.append(Probe(pd.name, pd.quantity, comp, pd.measure, el_all, xi_all, eta_all, th_all, k, local,
                          pd.reduce, pd.scale, unit=pd.unit, sampling=pd.sampling, frame=pd.frame))
     return out
+
+
+def _absent_layer(model, f: str, k: int, element: int, X, moved: str) -> None:
+    """The error of a probe on a layer that the [[stacks]] leave out at its point."""
+    from .errors import InputError
+
+    there = [model.layers[j].name for j in model.stacks[model.element_stack[element]]]
+    X = np.round(np.asarray(X, float), 6).tolist()
+    raise InputError(f"'{f}.layer': layer '{model.layers[k].name}' is absent at the probe point {X} (the [[stacks]] "
+                     f"leave it out there; the layers there are {there}), so the probe would read a layer that does "
+                     f"not exist; move '{f}.{moved}' to where the layer lies, or name one of {there}")
 
 
 REACTION_COMPONENTS = ("x", "y", "z", "mx", "my", "mz")

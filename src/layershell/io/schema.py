@@ -511,7 +511,9 @@ class ProbeDef(Strict):
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
     layer: str | None = Field(None, description=(
         "the layer meant (where theta3 lies on a layer boundary); traction and debonded_area: the layer above the "
-        "interface; reaction: only the force on that layer at the nodes (default: all layers)"))
+        "interface; reaction: only the force on that layer at the nodes (default: all layers). Displacement, "
+        "stress and traction probes must lie where the layer exists ([[stacks]]); a point on the end of the "
+        "layer reads an element that holds it"))
     reduce: Literal["max", "min", "absmax", "mean", "none"] = Field("none", description=(
         "how the values at several nodes or heights become one number"))
     scale: FiniteFloat = Field(1.0, description="factor on the value (e.g. -1 for a downward deflection)")
