@@ -9,8 +9,8 @@ the table in docs/user-guide.md. Uses the path tracer of tests/test_lapshear.py.
 ``--friction``: the example's bond with friction (μ0 = 0.95) and a stick penalty alpha_T of 1e5 or
 1e6 N/mm³, at the example's arc length and at a half, a quarter and a tenth of it (the
 ``arc_fraction`` of the test's trace), run to 3 % below the peak: increments, the peak above
-P_u (the friction's share, 0.35 % rigid-plastic) and the time (docs/performance.md, "Where
-friction sets the iteration count").
+P_u (the friction's share, 0.35 % rigid-plastic) and the time (docs/performance.md, "The
+cohesive slab").
 """
 from __future__ import annotations
 
