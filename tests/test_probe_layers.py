@@ -137,3 +137,16 @@ def test_probe_at_layer_end_reads_the_layer(tmp_path):
         assert abs(p["t13_in"]) > 1.0  # the bond shear at the end
         assert p["t13_end"] == pytest.approx(p["t13_in"], rel=1e-4)
         assert p["t33_end"] == pytest.approx(p["t33_in"], rel=1e-4)
+
+
+def test_load_on_absent_layer_fails_check(tmp_path):
+    """`check` builds the loads as `run` does: a nodal load on the soffit layer at x = 0, where
+    [[stacks]] leave it out, is exit 2 naming 'loads' in both (before: check said OK and run
+    stopped with an internal error)."""
+    load = '\n[[loads]]\ntype = "nodal"\nwhere = "near(x, 0)"\nlayer = "trc"\nvalue = [0, 0, 1]\n'
+    _write(tmp_path, load)
+    for command in (["check", "strip.toml"], ["run", "strip.toml", "-o", "out", "-q"]):
+        res = _cli(tmp_path, command)
+        assert res.exit_code == 2, res.output
+        text = " ".join(res.output.split())
+        assert "'loads'" in text and "'trc' does not exist" in text and "Traceback" not in text

@@ -174,19 +174,21 @@ def _directions(M) -> list[str]:
 def check(model: Path = typer.Argument(..., help="model file (TOML)")):
     """Validate a model file without solving."""
     spec = _load(model)
-    from .constraints import ConstraintError, constraint_operator
-    from .dofs import number_dofs
+    from .constraints import ConstraintError
+    from .loads import LoadError
+    from .solver.problem import Problem
 
-    try:
-        dm = number_dofs(spec.model)
-        op = constraint_operator(spec.model, dm)
+    try:  # the problem as `run` builds it: bonds, initially debonded zones and cohesive interfaces included
+        problem = Problem.build(spec.model)
     except ConstraintError as exc:
         _fail(f"{model}: 'supports': {exc}")
+    except LoadError as exc:
+        _fail(f"{model}: 'loads': {exc}")
     except Exception as exc:
         if _traceback_wanted():
             raise
-        _fail(f"{model}: the supports and layer bonds could not be set up ({type(exc).__name__}: {exc}); "
-              "check 'supports' (set LAYERSHELL_TRACEBACK=1 to see where it failed)")
+        _fail(f"{model}: the supports, layer bonds, loads and interfaces could not be set up ({type(exc).__name__}: "
+              f"{exc}); check 'supports', 'loads' and 'interfaces' (set LAYERSHELL_TRACEBACK=1 to see where it failed)")
     m = spec.model
     pf = spec.path_following
     if pf is None:
@@ -195,7 +197,14 @@ def check(model: Path = typer.Argument(..., help="model file (TOML)")):
         steps = (f"{'arc length' if pf.control == 'arc_length' else 'adaptive load steps'} to λ = {pf.lambda_end:g} "
                  f"(first increment {pf.increment:g}, at most {pf.max_steps} increments)")
     out.print(f"{model}: OK — {m.mesh.n_elements} elements, {m.mesh.n_nodes} nodes, {len(m.layers)} layer(s), "
-              f"{op.n_red} DOFs, {steps}, {len(spec.probes)} probe(s)", soft_wrap=True)
+              f"{_dof_counts(problem.op.n_red, problem.dm.n_full)}, {steps}, {len(spec.probes)} probe(s)",
+              soft_wrap=True)
+
+
+def _dof_counts(unknowns: int, all_dofs: int) -> str:
+    """The DOF counts of `check` and `run`: the unknowns solved for (after the supports, bonds and
+    ties) at the start, and all DOFs of the layers."""
+    return f"{unknowns} unknowns after constraints ({all_dofs} DOFs in all)"
 
 
 @app.command()
@@ -223,6 +232,7 @@ def run(
     from .checkpoint import CheckpointError
     from .constraints import ConstraintError
     from .formula import FormulaError
+    from .loads import LoadError
     from .recorder import ResultsFolderError
     from .runner import raise_terminated
     from .runner import run as run_model
@@ -266,6 +276,8 @@ def run(
                 failure = (f"{model}: {exc}", 2)
             except ConstraintError as exc:
                 failure = (f"{model}: 'supports': {exc}", 2)
+            except LoadError as exc:
+                failure = (f"{model}: 'loads': {exc}", 2)
             except FormulaError as exc:
                 failure = (f"{model}: a formula or value in the model file cannot be evaluated ({exc}); "
                            "check the load magnitudes and distributions", 2)
@@ -305,7 +317,8 @@ def run(
     if not quiet:
         for k, v in s["probes"].items():
             out.print(f"  {k:24s} = {v: .6g}", highlight=False)
-        out.print(f"{s['n_elements']} elements, {s['n_dofs']} DOFs, {len(s['steps'])} step(s), "
+        out.print(f"{s['n_elements']} elements, {_dof_counts(s['n_dofs'], s['n_dofs_full'])}, "
+                  f"{len(s['steps'])} step(s), "
                   f"{s['wall_seconds']:.2f} s — results in {out_dir}/ (summary.json, probes.csv, run.log, "
                   "*.vtu, *.pvd)", soft_wrap=True, highlight=False)
     if not res.converged:
