@@ -207,21 +207,212 @@ def graded(n: int, ratio: float = 1.0) -> np.ndarray:
     return out
 
 
+def _distinct(values: np.ndarray, tol: float) -> np.ndarray:
+    """Sorted ``values`` with those closer than ``tol`` to the previous one dropped."""
+    v = np.sort(values)
+    return v[np.concatenate([[True], np.diff(v) > tol])] if v.size else v
+
+
+def _size_knots(length: float, refine: np.ndarray, ratio: float) -> tuple[np.ndarray, np.ndarray]:
+    """Knots and values of the piecewise linear element-size field along [0, length]: 1 at the
+    refine points, rising linearly with the distance from the nearest one to ``ratio`` at the
+    farthest point (uniform without refine points)."""
+    if refine.size == 0 or ratio == 1.0:
+        return np.array([0.0, length]), np.ones(2)
+    knots = _distinct(np.concatenate([[0.0, length], refine, 0.5 * (refine[:-1] + refine[1:])]), 0.0)
+    dist = np.abs(knots[:, None] - refine[None, :]).min(1)
+    return knots, 1.0 + (ratio - 1.0) * dist / dist.max()
+
+
+def _density_integral(x: np.ndarray, knots: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """∫₀ˣ ds / h(s) for the piecewise linear size field (``knots``, ``h``), exact per piece."""
+    dk, dh = np.diff(knots), np.diff(h)
+    flat = np.abs(dh) <= 1e-12 * h[:-1]
+    slope = np.where(flat, 1.0, dh / np.where(dk > 0, dk, 1.0))
+    full = np.where(flat, dk / h[:-1], np.log(h[1:] / h[:-1]) / slope)
+    cum = np.concatenate([[0.0], np.cumsum(full)])
+    k = np.clip(np.searchsorted(knots, x, side="right") - 1, 0, dk.size - 1)
+    part = x - knots[k]
+    inner = np.where(flat[k], part / h[k], np.log1p(slope[k] * part / h[k]) / slope[k])
+    return cum[k] + inner
+
+
+def _density_inverse(target: np.ndarray, knots: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The x at which :func:`_density_integral` reaches ``target`` (inverse, exact per piece)."""
+    cum = _density_integral(knots, knots, h)
+    dk, dh = np.diff(knots), np.diff(h)
+    flat = np.abs(dh) <= 1e-12 * h[:-1]
+    slope = np.where(flat, 1.0, dh / np.where(dk > 0, dk, 1.0))
+    k = np.clip(np.searchsorted(cum, target, side="right") - 1, 0, dk.size - 1)
+    rest = target - cum[k]
+    inner = np.where(flat[k], rest * h[k], h[k] * np.expm1(slope[k] * rest) / slope[k])
+    return knots[k] + inner
+
+
+def _share_out(n: int, weight: np.ndarray) -> np.ndarray:
+    """``n`` elements shared out over pieces in proportion to ``weight``, at least one each
+    (largest remainders)."""
+    target = n * weight / weight.sum()
+    count = np.maximum(1, np.floor(target).astype(np.int64))
+    while count.sum() > n:  # the minimum of one took elements from the others
+        spare = np.flatnonzero(count > 1)
+        count[spare[np.argmin((target - count)[spare])]] -= 1
+    while count.sum() < n:
+        count[np.argmax(target - count)] += 1
+    return count
+
+
+def _corners_on_lines(length: float, n: int, breaks: np.ndarray, knots: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The n + 1 element corners: every break is a corner, and within each piece between breaks
+    the corners divide the integral of 1/h into equal parts."""
+    at = _density_integral(breaks, knots, h)
+    count = _share_out(n, np.diff(at))
+    piece = np.repeat(np.arange(count.size), count)
+    step = np.concatenate([np.arange(c) for c in count])
+    target = at[piece] + step * (np.diff(at) / count)[piece]
+    corners = np.concatenate([_density_inverse(target, knots, h), [length]])
+    corners[np.cumsum(np.concatenate([[0], count]))] = breaks  # the lines exactly, not to round-off
+    return corners
+
+
+def node_lines(length: float, n: int, lines=(), refine=(), ratio: float = 1.0, start: float = 0.0) -> np.ndarray:
+    """The 2n+1 node coordinates in [start, start + length] of ``n`` elements along one side, with
+    element corners exactly at every coordinate of ``lines`` and ``refine`` and at both ends.
+
+    Without ``refine`` the elements are shared out over the pieces between lines in proportion
+    to their length and are equal within each piece. With ``refine``, the element size grows
+    linearly with the distance from the nearest refine point, so that the longest element over
+    the shortest is ``ratio`` (to round-off, or as close as the integer element counts
+    allow; MeshError if they miss it by more than 10 %); this grades towards both ends, an
+    interior line or any set of lines. Mid-side nodes lie at the element midpoints."""
+    length, start = float(length), float(start)
+    tol = 1e-9 * length
+    as_given = np.concatenate([np.asarray(lines, float).ravel(), np.asarray(refine, float).ravel()])
+    given, refine = as_given - start, np.asarray(refine, float).ravel() - start
+    outside = given[(given < -tol) | (given > length + tol)]
+    if outside.size:
+        raise MeshError(f"node line at {outside[0] + start:.9g} lies outside [{start:.9g}, {start + length:.9g}]")
+    breaks = _distinct(np.concatenate([[0.0, length], np.clip(given, 0.0, length)]), tol)
+    if breaks.size - 1 > n:
+        raise MeshError(f"{n} element(s) cannot put corners at {breaks.size} node lines {(breaks + start).tolist()}; "
+                        f"give at least {breaks.size - 1} elements")
+    ref = _distinct(np.clip(refine, 0.0, length), tol)
+
+    def corners(size_ratio: float) -> np.ndarray:
+        return _corners_on_lines(length, n, breaks, *_size_knots(length, ref, size_ratio))
+
+    def achieved(c: np.ndarray) -> float:
+        el = np.diff(c)
+        return float(el.max() / el.min())
+
+    c = corners(1.0)
+    if ref.size and ratio != 1.0 and n > 1:
+        lo, hi = 0.0, np.log(ratio)  # bisection on the log of the size field's ratio
+        while achieved(corners(np.exp(hi))) < ratio and hi < 60.0:
+            lo, hi = hi, 2.0 * hi
+        best = None
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            cm = corners(np.exp(mid))
+            r = achieved(cm)
+            if best is None or abs(np.log(r / ratio)) < abs(np.log(achieved(best) / ratio)):
+                best = cm
+            if abs(r / ratio - 1.0) < 1e-12:
+                break
+            lo, hi = (mid, hi) if r < ratio else (lo, mid)
+        c = best
+        if abs(achieved(c) / ratio - 1.0) > 0.1:
+            el = np.diff(c)
+            raise MeshError(f"the ratio {ratio:.6g} cannot be reached with {n} element(s) and node lines at "
+                            f"{(breaks + start).tolist()} (closest: element lengths {el.min():.6g} to {el.max():.6g}, "
+                            f"ratio {achieved(c):.4g}); give more elements or a ratio near {achieved(c):.3g}")
+    c = start + c
+    c[np.abs(given[:, None] - (c - start)[None]).argmin(1)] = as_given  # the lines as written, not recomputed
+    c[0], c[-1] = start, start + length
+    out = np.empty(2 * n + 1)
+    out[0::2] = c
+    out[1::2] = 0.5 * (c[:-1] + c[1:])
+    return out
+
+
 def rectangle(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0, 0.0), normal: str = "+z",
-              grading_x: float = 1.0, grading_y: float = 1.0) -> Mesh:
+              grading_x: float = 1.0, grading_y: float = 1.0, lines_x=(), lines_y=(), refine_x=(), refine_y=(),
+              refine_ratio_x: float = 1.0, refine_ratio_y: float = 1.0) -> Mesh:
     """Flat rectangular plate in the x-y plane; ``normal`` '+z' (reference face at the bottom)
     or '-z' (reference face on top, material below). ``grading_x``/``grading_y``: size of the
-    last element over the first along x/y (geometric; < 1 refines towards the far edge)."""
+    last element over the first along x/y (geometric; < 1 refines towards the far edge).
+
+    ``lines_x``/``lines_y`` (absolute coordinates, origin included): element edges lie exactly
+    there; ``refine_x``/``refine_y``: node lines towards which the elements shrink, the longest
+    over the shortest being ``refine_ratio_x``/``refine_ratio_y`` (:func:`node_lines`). Either
+    these or ``grading_x``/``grading_y`` along one side, not both."""
     o = np.asarray(origin, float)
-    gx, gy = graded(nx, grading_x), graded(ny, grading_y)
+
+    def side(length, n, grading, lines, refine, ratio, start, name):
+        if len(lines) == 0 and len(refine) == 0:
+            return o[start] + length * graded(n, grading)
+        if grading != 1.0:
+            raise MeshError(f"grading_{name} grades from one edge; with lines_{name} or refine_{name} give the "
+                            f"edges to refine towards in refine_{name} instead")
+        try:
+            return node_lines(length, n, lines, refine, ratio, o[start])
+        except MeshError as exc:
+            raise MeshError(f"along {name} (lines_{name}, refine_{name}, refine_ratio_{name}, n{name}): {exc}") from None
+
+    gx = side(lx, nx, grading_x, lines_x, refine_x, refine_ratio_x, 0, "x")
+    gy = side(ly, ny, grading_y, lines_y, refine_y, refine_ratio_y, 1, "y")
 
     def fn(s, t):
         i, j = np.rint(s * 2 * nx).astype(int), np.rint(t * 2 * ny).astype(int)
-        return np.stack([o[0] + lx * gx[i], o[1] + ly * gy[j], o[2] + 0 * s], -1)
+        return np.stack([gx[i], gy[j], o[2] + 0 * s], -1)
 
     mesh = _structured(nx, ny, fn, ("xmin", "xmax", "ymin", "ymax"))
     sign = -1.0 if normal.strip().startswith("-") else 1.0
     return _orient(mesh, lambda c: np.tile([0.0, 0.0, sign], (len(c), 1)))
+
+
+def _inner_grid(mesh: Mesh, elements: np.ndarray, n: int) -> np.ndarray:
+    """(e, n, n, 3) points of ``elements`` on an n × n grid just inside each element
+    (ξ, η ∈ ±(1 − 10⁻⁶)), rows along η, columns along ξ."""
+    from .element.shape import quad9
+
+    t = np.linspace(-1.0 + 1e-6, 1.0 - 1e-6, n)
+    xi, eta = np.meshgrid(t, t, indexing="xy")
+    shape, _, _ = quad9(xi.ravel(), eta.ravel())  # (n², 9)
+    pts = np.einsum("qn,eni->eqi", shape, mesh.nodes[mesh.elements[elements]])
+    return pts.reshape(len(elements), n, n, 3)
+
+
+def elements_cut_by(mesh: Mesh, inside, n: int = 7) -> np.ndarray:
+    """Ids of the elements that a region's boundary crosses instead of following their edges:
+    ``inside(points (m, 3)) -> (m,) bool`` takes both values on an n × n grid just inside them."""
+    pts = _inner_grid(mesh, np.arange(mesh.n_elements), n).reshape(-1, 3)
+    flags = np.asarray(inside(pts), bool).reshape(mesh.n_elements, n * n)
+    return np.flatnonzero(flags.any(1) & ~flags.all(1))
+
+
+def axis_crossings(mesh: Mesh, inside, elements: np.ndarray, n: int = 7) -> tuple[np.ndarray, np.ndarray]:
+    """Where a region's boundary crosses ``elements`` of a flat mesh with axis-parallel edges:
+    the distinct x at which ``inside`` changes along lines of constant y through them, and the
+    distinct y along lines of constant x (n lines each, located by bisection to 10⁻¹² of the
+    element size), rounded to 10⁻⁹ of the mesh size in decimal digits."""
+    grid = _inner_grid(mesh, np.asarray(elements, np.int64), n)
+    rows, cols = grid, grid.transpose(0, 2, 1, 3)  # lines along ξ, then along η
+    a = np.concatenate([rows[:, :, :-1].reshape(-1, 3), cols[:, :, :-1].reshape(-1, 3)])
+    b = np.concatenate([rows[:, :, 1:].reshape(-1, 3), cols[:, :, 1:].reshape(-1, 3)])
+    fa, fb = np.asarray(inside(a), bool), np.asarray(inside(b), bool)
+    a, b, fa = a[fa != fb], b[fa != fb], fa[fa != fb]
+    for _ in range(45):
+        mid = 0.5 * (a + b)
+        same = np.asarray(inside(mid), bool) == fa
+        a = np.where(same[:, None], mid, a)
+        b = np.where(same[:, None], b, mid)
+    step = np.abs(b - a)
+    at = 0.5 * (a + b)
+    along_x = step[:, 0] >= step[:, 1]
+    digits = int(9 - np.floor(np.log10(mesh.size())))
+    tol = 1e-9 * mesh.size()
+    return _distinct(np.round(at[along_x, 0], digits), tol), _distinct(np.round(at[~along_x, 1], digits), tol)
 
 
 def cylinder(radius: float, angle_start: float, angle_end: float, width: float, n_arc: int, n_width: int,

@@ -97,6 +97,42 @@ class RectangleMesh(MeshBase):
         1.0, ge=1e-4, le=1e4, description="size of the last element along x over the first (geometric grading; > 1 refines "
                                  "towards the origin edge, < 1 towards x = origin + lx; 1: uniform)")
     grading_y: PositiveFloat = Field(1.0, ge=1e-4, le=1e4, description="the same along y")
+    lines_x: list[float] = Field([], description=(
+        "x of node lines (length, origin included): element edges lie exactly there, e.g. at plate ends, load "
+        "lines and the boundaries of [[stacks]] regions; the nx elements are shared out over the pieces between "
+        "lines in proportion to their length"))
+    lines_y: list[float] = Field([], description="the same along y (ny elements)")
+    refine_x: list[float] = Field([], description=(
+        "x of node lines (edges included) towards which the elements shrink, e.g. both ends [x0, x0 + lx] or an "
+        "interior line; each is a node line; the element length grows linearly with the distance from the "
+        "nearest one; with refine_ratio_x, not with grading_x"))
+    refine_y: list[float] = Field([], description="the same along y")
+    refine_ratio_x: float = Field(1.0, ge=1.0, le=1e4, description=(
+        "with refine_x: the longest element along x over the shortest (exactly where the element counts "
+        "allow, an error when they miss it by more than 10 %)"))
+    refine_ratio_y: float = Field(1.0, ge=1.0, le=1e4, description="the same along y")
+
+    @model_validator(mode="after")
+    def _node_lines(self):
+        for axis, start, length in (("x", self.origin[0], self.lx), ("y", self.origin[1], self.ly)):
+            for key in (f"lines_{axis}", f"refine_{axis}"):
+                for i, v in enumerate(getattr(self, key)):
+                    if not math.isfinite(v) or not -1e-9 * length <= v - start <= length * (1 + 1e-9):
+                        raise ValueError(f"{key}[{i}] = {v} lies outside the rectangle ({axis} from {start:.9g} to "
+                                         f"{start + length:.9g}); give {axis} within it (absolute coordinates, "
+                                         "origin included)")
+            refine, ratio = getattr(self, f"refine_{axis}"), getattr(self, f"refine_ratio_{axis}")
+            if refine and ratio == 1.0:
+                raise ValueError(f"refine_{axis} needs refine_ratio_{axis} > 1 (the longest element over the "
+                                 f"shortest), e.g. refine_ratio_{axis} = 4")
+            if ratio != 1.0 and not refine:
+                raise ValueError(f"refine_ratio_{axis} = {ratio} needs refine_{axis}: the node lines to refine "
+                                 f"towards, e.g. refine_{axis} = [{start:.6g}, {start + length:.6g}] for both edges")
+            if getattr(self, f"grading_{axis}") != 1.0 and (refine or getattr(self, f"lines_{axis}")):
+                raise ValueError(f"grading_{axis} grades from one edge and cannot be combined with lines_{axis} or "
+                                 f"refine_{axis}; refine towards that edge with refine_{axis} = [{start:.6g}] and "
+                                 f"refine_ratio_{axis} instead")
+        return self
 
 
 class CylinderMesh(MeshBase):
