@@ -31,7 +31,7 @@ PINCHED_REF = 1.8248e-5
 # The Scordelis-Lo roof as a 3D linear-elastic solid (benchmarks/scordelis_solid.py, docs/vs_solid.md
 # §3: quadratic hexahedra graded towards the free edge, Richardson-extrapolated, ± 0.00002): the
 # self-weight as a body force (load="volume"), and the same 90 per middle-surface area applied on
-# the outer face (load="outer", the default of this example before 2026-11-26). layershell's MITC9 element with
+# the outer face (load="outer"). layershell's MITC9 element with
 # d = 3 on the graded mesh gives both to 1e-6.
 SCORDELIS_3D = {"volume": 0.30148, "outer": 0.30648}
 
