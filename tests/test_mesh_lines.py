@@ -199,3 +199,24 @@ def test_stack_boundary_on_the_named_node_lines_is_accepted(tmp_path):
     assert np.array_equal(spec.model.element_stack == 0, (c[:, 0] > 1) & (c[:, 1] < 0.3))
     on_edges = Case("cantilever_thick.toml", _stacks("x > 2 and x < 8"), inprocess=True)
     assert _outcome(tmp_path, "on_edges", on_edges).returncode == 0
+
+
+def test_the_user_guide_example_builds_the_mesh_it_describes():
+    """The [mesh] example of docs/user-guide.md: node lines at 0.1, 1.5 and 2.9, elements at the
+    plate ends 10 times shorter than the longest."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    from layershell.io.build import _mesh
+    from layershell.io.schema import RectangleMesh
+
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "user-guide.md").read_text(encoding="utf-8")
+    block = next(b for b in re.findall(r"```toml\n(.*?)```", guide, re.S) if "refine_ratio_x" in b)
+    block = "\n".join(line.strip() for line in block.splitlines())
+    m = _mesh(RectangleMesh.model_validate(tomllib.loads(block)["mesh"]), Path("."))
+    el, cx = _lengths(m, 0), _corners(m, 0)
+    assert all(np.any(cx == v) for v in (0.1, 1.5, 2.9))
+    assert abs(el.max() / el.min() / 10.0 - 1) < 1e-3
+    k = np.flatnonzero(cx == 0.1)[0]
+    assert el.min() == min(el[k - 1], el[k])  # the shortest element touches a plate end
