@@ -646,7 +646,7 @@ class InterfaceDef(Strict):
     law: Literal["thesis", "cohesive"] = Field(
         "thesis", description="\"thesis\": bond released node by node by the stress criterion (4.15) (MODEL.md §9); "
                               "\"cohesive\": both layers keep their own DOFs, coupled by a damaging cohesive law "
-                              "with onset by sigma_max/tau_max/p and propagation by G_Ic, G_IIc (issue 13)")
+                              "with onset by sigma_max/tau_max/p and propagation by G_Ic, G_IIc")
     G_Ic: float | None = Field(None, description="cohesive: mode I fracture energy (energy per area, e.g. kN/m = N/mm)")
     G_IIc: float | None = Field(None, description="cohesive: mode II fracture energy (energy per area)")
     eta: PositiveFloat = Field(2.0, description="cohesive: Benzeggagh–Kenane exponent η of G_c = G_Ic + (G_IIc - G_Ic) B^η")
