@@ -434,8 +434,8 @@ class Assembler:
         """The constant part of a geometrically linear model (``nonlinear = false``): the layer
         elements' K in the full pattern, built on first use; None for a nonlinear model, a model
         without interface or contact blocks, or without Numba. A linear element's K_e does not depend on u, so every tangent only adds
-        the extra blocks (cohesive interfaces, contact) to it (issue 13: the DCB, ENF and
-        lap-shear models spent most of an iteration re-forming the same element tangents); the
+        the extra blocks (cohesive interfaces, contact) to it (re-forming the same element
+        tangents would take most of an iteration of the DCB, ENF and lap-shear models); the
         internal forces still come from the kernel (:meth:`_layer_forces`)."""
         if self.model.nonlinear or _jit() is None or not self.blocks or not self.extra:
             return None  # (without extra blocks Newton takes one or two iterations a step: no cache, no memory)

@@ -35,9 +35,9 @@ import numpy as np
 
 from .io.output import atomic_write
 
-# 2: the cohesive interfaces' fracture energy per point (CohesiveRun.fracture), 27 Nov 2026
+# 2: the cohesive interfaces' fracture energy per point (CohesiveRun.fracture)
 # 3: the stick anchors of a cohesive interface's friction belong to a stick penalty per point
-#    (cohesive.stick_penalty), 29 Nov 2026
+#    (cohesive.stick_penalty)
 FORMAT_VERSION = 3
 FILENAME = "checkpoint.npz"
 

@@ -1,4 +1,4 @@
-"""Cohesive (energy-based) interface law, issue 13: damage onset by a strength criterion,
+"""Cohesive (energy-based) interface law: damage onset by a strength criterion,
 propagation by the fracture energies G_Ic, G_IIc with the Benzeggagh–Kenane mixed-mode law.
 
 Material point (pure functions over arrays of points). Separation δ = Δu (upper layer's bottom
@@ -35,7 +35,7 @@ FULL_DAMAGE = 1.0 - 1e-9
 
 @dataclass(frozen=True)
 class CohesiveLaw:
-    """Parameters of a cohesive interface (issue 13).
+    """Parameters of a cohesive interface.
 
     G_Ic, G_IIc: fracture energies (energy per area); eta: Benzeggagh–Kenane exponent;
     sigma_max, tau_max, p: strengths and exponent of the onset criterion; onset: "thesis" (4.15)
@@ -464,7 +464,7 @@ class CohesiveBlock:
         stiffness drops from K to the softening slope, and the normal stiffness of a damaged
         point at δ_n = 0 - are then handled by the active-set loop (:func:`~layershell.solver.
         newton.newton`): semi-smooth Newton across the onset kink can cycle between the states
-        of a few points at the crack tip (DCB, issue 13). Where friction acts on the damaged
+        of a few points at the crack tip (DCB). Where friction acts on the damaged
         share, its stick state is frozen too (``contact.stick_frozen``: a point frozen sticking
         keeps the stick law beyond its slip limit; :meth:`set_violation` checks it).
 

@@ -27,10 +27,10 @@ from .model import Model
 
 #: shape of the slip limit in the friction return mapping: ``inf`` (default) is the exact
 #: penalty return mapping f(x) = min(x, 1) (elastic stick with the penalty α_T, sliding at the
-#: limit); a finite n gives the smooth f(x) = x/(1 + x^n)^(1/n) (f(1) = 0.917 for n = 8). The
-#: smooth form was the default before: Newton on it converges slowly when many points pass the
-#: limit (like Newton on arctan), so the pull-off example needed about 3x the iterations; the
-#: §5.1 plate gives the same w_front_max (to 4 digits) with both
+#: limit); a finite n gives the smooth f(x) = x/(1 + x^n)^(1/n) (f(1) = 0.917 for n = 8). Newton
+#: on the smooth form converges slowly when many points pass the limit (like Newton on arctan):
+#: the pull-off example needs about 3x the iterations; the §5.1 plate gives the same w_front_max
+#: (to 4 digits) with both
 FRICTION_SHARPNESS = float("inf")
 
 

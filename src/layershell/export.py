@@ -247,7 +247,7 @@ def interface_mesh(model: Model, dm: DofMap, u_full: np.ndarray, itf, run=None, 
     ne = itf.elements.size
     point_data = {"traction": t, "sigma13": t[:, 0], "sigma23": t[:, 1], "sigma33": t[:, 2],
                   "shear": np.hypot(tm[:, 0], tm[:, 1]), "displacement": ps.u}
-    if run is not None and hasattr(run.block, "d_old"):  # cohesive interface (issue 13)
+    if run is not None and hasattr(run.block, "d_old"):  # cohesive interface
         inv = np.argsort(run.block.region)
         pick = lambda a: a[:, inv].reshape(ne * 9, *a.shape[2:])  # noqa: E731
         delta = run.block.separation(u_full)

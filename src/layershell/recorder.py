@@ -1,4 +1,4 @@
-"""The one writer of a results folder (issue 15): the runner hands it each converged step.
+"""The one writer of a results folder: the runner hands it each converged step.
 
 :class:`Recorder` alone writes into the folder of ``layershell run``: summary.json, probes.csv,
 delamination.csv, steps.jsonl, run.log, the ParaView files, checkpoint.npz and the figures. It

@@ -4,7 +4,7 @@ NumPy's vector operations (norms and dot products of the residual, O(n) updates)
 which splits them over its threads above a few thousand entries. For vectors of 10⁴-10⁵ entries
 that gains nothing and costs the threads' wake-up: measured here on a 29 000-entry vector,
 ``np.linalg.norm`` took 15 µs on one thread and 1.9 ms with OpenBLAS's default threads on a busy
-2-core machine, and the DCB run (issue 13) spent a quarter of its CPU time there. A run therefore
+2-core machine, and the cohesive DCB spends a quarter of its CPU time there. A run therefore
 holds OpenBLAS to one thread. The parallel parts keep their own threads: the element kernel (its
 pool, ``LAYERSHELL_THREADS``) and MKL PARDISO (MKL's threads, not OpenBLAS's).
 """

@@ -86,7 +86,7 @@ class LocalAssembly:
         self.model, self.dm, self.op, self.chunk = model, dm, op, chunk
         self.elements = np.asarray(elements, np.int64)
         self.blocks = local_blocks(model, dm, self.elements)
-        # element-like interface blocks (cohesive, issue 13): ``(block, rows)`` - the block's
+        # element-like interface blocks (cohesive): ``(block, rows)`` - the block's
         # element rows this rank inserts (its fixed pattern is part of the preallocation)
         # (rows of the block's assembly form: its face points on the nodal rule, see
         # ``layershell.assembly._assembly_dofs``)

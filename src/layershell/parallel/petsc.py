@@ -10,7 +10,7 @@ Tᵀ(λF - f_int) is a distributed PETSc vector. The default solver is KSP ``pre
 (direct, reproduces the serial solution to round-off); ``gamg`` gives CG + algebraic multigrid.
 The solution is gathered on every rank (``Scatter.toAll``) and expanded u = T u_r there.
 
-Cohesive interfaces (issue 13): the blocks and their damage state are replicated (the serial
+Cohesive interfaces: the blocks and their damage state are replicated (the serial
 ``InterfaceController``), each rank assembles the block rows on its elements (part of the exact
 preallocation), and :class:`DistributedProblem` offers the interface of
 :class:`layershell.solver.problem.Problem`, so that the serial ``load_steps``/``newton``
@@ -140,7 +140,7 @@ class DistributedProblem:
         below = model.below()
         self.bonded = {up: dm.present[up] & dm.present[lo] for up, lo in below.items()}
         self.F_scaled, self.F_const = external_forces(model, dm)
-        # cohesive interfaces (issue 13): the serial InterfaceController, replicated on every rank
+        # cohesive interfaces: the serial InterfaceController, replicated on every rank
         # (same blocks, same damage state; the block is small next to the shell elements); it
         # unbonds the cohesive interfaces before T is built
         self.extra_blocks: list = []

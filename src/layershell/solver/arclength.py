@@ -255,8 +255,7 @@ ENERGY_FLOOR = 1e-3
 #: the energy-error step control acts once the run's balance error exceeds this (half the 1 %
 #: at which the runner warns, ENERGY_WARN)
 ENERGY_CONTROL_FROM = 0.005
-#: |external work - stored - dissipated| / external work above which a run warns (runner._balance;
-#: issue 13: 1 %)
+#: |external work - stored - dissipated| / external work above which a run warns (runner._balance)
 ENERGY_WARN = 0.01
 
 
@@ -320,10 +319,10 @@ def friction_excess(problem: Problem, u: np.ndarray, gradient: bool = False) -> 
     (:meth:`~layershell.cohesive.CohesiveBlock.friction_excess`), and (``gradient``) ∂c/∂u in
     the full space (zeros where no friction acts). Both forms of the dissipation constraint take
     the stored energy to be the secant one; the dissipation of an increment is ΔG + c(u) − c(u₀).
-    Without Δc the constraint was met by friction alone: the lap shear with stiff friction
-    (alpha_T = 1e6) at a tenth of the example's arc length had 264 of its increments refused as
-    friction's (FRICTION_REFUSED) and stopped on its plateau, 1.3 % below its peak, at λ = 1.00014;
-    with it 13, and the path goes on (tests/test_lapshear.py)."""
+    Without Δc friction alone can meet the constraint: the lap shear with stiff friction
+    (alpha_T = 1e6) at a tenth of the example's arc length would have 264 of its increments refused
+    as friction's (FRICTION_REFUSED) and stop on its plateau, 1.3 % below its peak; with Δc 13 are,
+    and the path goes on (tests/test_lapshear.py)."""
     c, grad = 0.0, (np.zeros(problem.dm.n_full) if gradient else None)
     for b in problem.assembler.extra:
         if not hasattr(b, "friction_excess"):
@@ -339,8 +338,8 @@ def interface_form(problem: Problem) -> bool:
     """Is the dissipation of an increment measured at the interfaces? On a geometrically nonlinear
     model with cohesive interfaces. Gutiérrez's ΔG = ½ F̂ᵀ(λ₀ Δu − Δλ u₀) takes the stored energy
     to be ½ λ F̂ᵀu, true of a linear bulk only: on a nonlinear one an elastic increment 'dissipates'
-    (the §5.1 plate with MITC9 on 6 × 6: the dissipation-controlled increments shrank to 10⁻⁷ of
-    the first at λ = 0.895 and the path never reached λ = 1; with ``nonlinear = false`` it does).
+    (the §5.1 plate with MITC9 on 6 × 6: Gutiérrez's form shrinks the dissipation-controlled
+    increments to 10⁻⁷ of the first at λ = 0.895 and the path never reaches λ = 1).
     The energy the interfaces take, less what they store, does not involve the bulk:
 
         ΔG = ½(f_I(u₀) + f_I(u))·Δu − (ψ_I(u) − ψ_I(u₀)) = ½(f_I(u₀)·u − f_I(u)·u₀)
@@ -393,7 +392,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
     :func:`~layershell.solver.newton.newton`. The tension state and the loading set are frozen
     at u0 for the predictor (the points softening there keep softening in it), then at the
     predictor's end (the points ahead of the front that it overloads load from the first
-    iteration on: the force-loaded DCB on 200 elements took 101 instead of 118 increments and
+    iteration on: the force-loaded DCB on 200 elements takes 101 instead of 118 increments and
     759 instead of 923 iterations), the constrained Newton iterations converge on the then
     smooth problem, the sets are checked at the solution and, where they changed, frozen there
     and the same increment iterated on, at most ``max_active_set_loops`` times. A frozen opening
@@ -650,11 +649,9 @@ def reversal_step(problem: Problem, u: np.ndarray, dU: np.ndarray) -> float:
     largest that carries no sliding point past its anchor
     (:meth:`~layershell.cohesive.CohesiveBlock.reversal_step`), at least
     :data:`REVERSAL_STEP_MIN`; 1 elsewhere. The stopped point then sticks, and the next
-    iteration has its stick stiffness. (The TRC slab by arc length on 8 × 6 stopped at
-    306.68 kN/m² on its snap-back, its residual stalled at 0.25 kN as about 30 sliding points
-    reversed together from one iterate to the next; restarted there with the frozen stick state
-    and this limit it went on to 302.76, and from the start, with :data:`FRICTION_REFUSED`'s
-    growth too, down to 288.16.)"""
+    iteration has its stick stiffness. (Without it the TRC slab by arc length on 8 × 6
+    stalls at 306.68 kN/m² on its snap-back, its residual at 0.25 kN, as about 30 sliding points
+    reverse together from one iterate to the next.)"""
     eta = 1.0
     for blk in problem.assembler.extra:
         if hasattr(blk, "reversal_step"):
@@ -683,8 +680,8 @@ def _release_closed(asm, u: np.ndarray) -> None:
     """Before the forces at a new iterate: frozen cohesive points that it closes leave the
     opening and loading sets (:meth:`~layershell.cohesive.CohesiveBlock.release_closed`: the
     frozen law jumps there). Arc length only: in the load-controlled loop of
-    :func:`~layershell.solver.newton.newton` it made the displacement-controlled DCB stop
-    earlier (δ = 4.2 instead of 10 mm on 150 elements, its loop cycling)."""
+    :func:`~layershell.solver.newton.newton` it would make the displacement-controlled DCB stop
+    early (δ = 4.2 instead of 10 mm on 150 elements, its loop cycling)."""
     for b in asm.extra:
         if getattr(b, "frozen", None) is not None and hasattr(b, "release_closed"):
             b.release_closed(u)
@@ -760,10 +757,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.arc_length = st.size = ps.arc_length if ps.arc_length is not None else _first_arc_length(problem, u, s, ps)
             st.arc_length0 = st.arc_length
     l0 = st.arc_length0
-    # the smallest arc length (a user setting: the 100-element DCB stops at δ = 10.7 mm with this
-    # default; measured in plain DOF units it stopped at 8.65 mm and went on to δ = 15.9 mm with
-    # arc_length_min = 1e-7, 1.3·10⁻⁷ of the first, while 10⁻⁶ or 10⁻⁹ of the first as the
-    # default still stopped at 8.65 mm)
+    # the smallest arc length (a user setting; the force-loaded 100-element DCB stops at δ = 10.7 mm
+    # with this default)
     dl_min = ps.arc_length_min if ps.arc_length_min is not None else l0 / 1000.0
     dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * l0
     inc_max = ps.increment_max if ps.increment_max is not None else 10.0 * ps.increment
@@ -876,20 +871,20 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
                 # from a state whose increment damaged, the arc length found the elastic unloading
                 # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
-                # elements, its crack past the load point, went from λ = 0.6078 to 0.6007 so and on
-                # down, 'unloads without damage'): the dissipation constraint next, which demands damage
+                # elements, its crack past the load point, would go from λ = 0.6078 down so,
+                # 'unloads without damage'): the dissipation constraint next, which demands damage
                 ok, msg = False, "the increment unloads elastically from a debonding state"
             if ok and ledger0 is not None and st.mode == "dissipation":
                 # the constraint takes the stored energy to be the secant one; where the structure
                 # unloads stiffer than the secant (crack faces closing, contact, friction) an
                 # elastic path meets it without damage - the prescribed opening of the DCB on 100
-                # elements 'converged' from δ = 6.2 mm back to 0 in one increment. The interfaces'
+                # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
                 # own ledger must book the dissipation. On displacement paths all of it counts; on
                 # force paths only damage, and only where the load falls (friction's work on
-                # sliding points met the constraint while the cohesive slab on 16 × 12 unloaded
-                # from 180.8 to 168 kN/m², its fracture ledger flat to 10⁻⁷, while load control
+                # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
+                # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
                 # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
-                # (Counting rising force increments too refused the lap shear with friction's
+                # (Counting rising force increments too would refuse the lap shear with friction's
                 # unloading past its peak, which `unloading` below stops with a clearer message.)
                 # A refused increment is cut, then tried by the arc length, then by a rescue
                 if displacement_path:
@@ -902,7 +897,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
                 # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
                 # through closure meets the constraint without any damage (the force-loaded DCB
-                # on 150 elements 'converged' from λ = 0.42 to -0.03 with its arms shut)
+                # on 150 elements would 'converge' from λ = 0.42 to -0.03 with its arms shut)
                 ok, msg = False, "the dissipation constraint crossed λ = 0 (closure, not damage)"
             if (ok and arc and st.mode == "load" and not allow_jump and measure is not None and ps.jump_area is not None
                     and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
@@ -916,8 +911,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     ok, msg = False, "probe jump"
             if ok and b0 is not None and (st.mode != "load" or rescue is None):
                 # (b0: arc-length control; its stretches of load-controlled increments too - the
-                # MMB's second rise to λ = 1, its crack still growing, took increments too long for
-                # the ledger: balance 1.8 % - but not a rescue, where a load-controlled increment
+                # MMB's second rise to λ = 1, its crack still growing, takes increments too long for
+                # the ledger without it: balance 1.8 % - but not a rescue, where a load-controlled increment
                 # is the last resort: a node row that releases within it is a jump of the path,
                 # which shorter increments do not resolve)
                 e_rel = energy_control(b0, balance_terms(problem, att.u), ps.energy_tolerance)
@@ -934,12 +929,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             if msg == FRICTION_REFUSED and _friction_acts(problem):
                 # too short an increment to damage: the constraint (secant unloading) is met by
                 # the energy that the friction's stick springs and the contact give back - a longer
-                # one damages. The TRC slab on 16 × 12 crawled on its snap-back at 305.90 kN/m²:
-                # increments of Δτ = 10⁻¹¹-10⁻⁷ booked 2·10⁻¹¹-4·10⁻¹⁰ of damage, refused from
-                # 3·10⁻¹¹ on and cut, while 10⁻⁶ to 10⁻³ booked 81-100 % (docs/performance.md).
+                # one damages. On the TRC slab's snap-back (16 × 12, 305.90 kN/m²) increments of
+                # Δτ = 10⁻¹¹-10⁻⁷ book 2·10⁻¹¹-4·10⁻¹⁰ of damage, 10⁻⁶ to 10⁻³ book 81-100 %.
                 # Where growing does not help (elastic unloading), cut from the refused size. An
-                # increment longer than the last accepted one went astray instead (the same slab,
-                # at 300.14 kN/m² after a node had debonded fully: Δτ = 8·10⁻⁵ ended at 143.7
+                # increment longer than the last accepted one goes astray instead (the same slab
+                # at 300.14 kN/m² after a node has debonded fully: Δτ = 8·10⁻⁵ ends at 143.7
                 # kN/m², grown ones at -305 and -132): it is cut
                 if grown < GROW_REFUSED and increment_length(problem, att.u - u) < st.arc_length:
                     size_refused = size_refused or st.size
@@ -964,9 +958,9 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 continue
             if st.mode == "dissipation" and tried_dissipation and cuts >= 3:
                 # it did not help: the arc length again, cut - from at least arc_length_restart, not
-                # from the length of the last accepted increment: the cohesive slab on 8 × 6 stopped
-                # so at 258.63 kN/m² on its plateau, where dissipation increments of Δτ ~ 10⁻⁸ had
-                # left the arc length at its smallest, one try (docs/performance.md)
+                # from the length of the last accepted increment, which dissipation increments of
+                # Δτ ~ 10⁻⁸ may have left at its smallest: a single try there stops the cohesive slab
+                # on 8 × 6 on its plateau at 258.63 kN/m²
                 st.mode, st.size = "arc", arc_length_restart(st.arc_length, st.arc_length0, dl_max)
             cuts += 1
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
@@ -986,7 +980,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 st.mode, st.size, st.changed, cuts = "arc", st.arc_length, True, 0
                 continue
             if st.mode == "load" and s.unstable == "relax" and not jump and (cuts > ps.relax_after_cuts or limit):
-                # a step without equilibrium nearby fails at every size (the 100-element DCB spent
+                # a step without equilibrium nearby fails at every size (the 100-element DCB spends
                 # ~100 iterations on each of up to 20 cuts of the step before a snap-back): relax
                 # at the load of the smallest cut to the next equilibrium
                 rel = relax(problem, u, lam, lam + st.size, s, on_step_end)
@@ -1061,13 +1055,13 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         elif (st.mode == "dissipation" and friction and used < DISSIPATION_INSENSITIVE_BELOW * st.dissipation_max
               and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
             # as below, where friction acts: each commit moves the friction's anchors and limits,
-            # and the count no longer falls with the size (the lap shear with alpha_T = 1e5: Δτ held
-            # at 0.2-0.7, 1/100 of its largest, by 8 iterations each, 703 instead of 142 increments)
+            # and the count no longer falls with the size (without this the lap shear with alpha_T = 1e5
+            # holds Δτ at 0.2-0.7, 1/100 of its largest, by 8 iterations each: 703 instead of 142 increments)
             fac = max(fac, INSENSITIVE_GROWTH)
         elif (st.mode in ("load", "arc")
               # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
-              # increments at any size (the slab on 16 × 12 took 6-10 iterations at Δλ = 0.4-5
-              # kN/m², and the plain rule shrank them from 5 to 0.4)
+              # increments at any size (the slab on 16 × 12 takes 6-10 iterations at Δλ = 0.4-5
+              # kN/m², and the plain rule would shrink them from 5 to 0.4)
               and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
                    or (arc and st.mode == "load"))
               and size_insensitive(used, its, history, ps.target_iterations)):
@@ -1110,7 +1104,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 stretch_from = lam
             stretch_accepted += 1
             if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
-                # to it otherwise: the slab on 16 × 12 went 323.5, 324.9, 325.29, 325.44, 325.456,
+                # to it otherwise: the slab on 16 × 12 would go 323.5, 324.9, 325.29, 325.44, 325.456,
                 # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
                 which = "one load-controlled increment" if stretch_accepted == 1 else "load-controlled increments"
                 warns.append(f"step {n}: {which} took the path from load factor {stretch_from:.6g} to {att.lam:.6g}, "
@@ -1168,8 +1162,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
                          start_inertia(problem))
         res.state = replace(st, du_prev=None if st.du_prev is None else st.du_prev.copy(),
-                            recent=list(st.recent), recent_dissipation=list(st.recent_dissipation))  # (a copy of every field: lam_damaged was
-        # left out of the field-by-field copy before, and a restart lost it)
+                            recent=list(st.recent), recent_dissipation=list(st.recent_dissipation))  # (a copy of every field, so that a
+        # restart from the checkpoint has all of them, lam_damaged included)
         res.warnings = warns
         res.dissipation = dG
         res.end = end_reason  # why the path ends here ("lambda_end", "complete failure", "max_steps"), else None
@@ -1225,8 +1219,8 @@ def stretch_may_start(ps: PathSettings, arc: bool, displacement_path: bool, cuts
     where the last stretch ended. On such a branch the equilibria of load control are the arc
     length's, and load control's Newton with its own active-set loop steps over the local
     snap-backs of single interface points that the arc length traces one by one: the cohesive
-    slab on 16 × 12 (test_slab_trc_soffit.py) rose from 242.44 kN/m² by 5 kN/m² in one
-    load-controlled increment (11 iterations), where its arc-length increments advanced
+    slab on 16 × 12 (test_slab_trc_soffit.py) rises from 242.44 kN/m² by 5 kN/m² in one
+    load-controlled increment (11 iterations), where its arc-length increments advance
     0.04-0.5 kN/m² each, with 4-7 cuts in every few. The stretch ends where a load-controlled
     increment fails within STRETCH_CUTS halvings or jumps, or after one that needed a halving
     (near a peak or a snap-back): the arc length traces it from there. (On displacement paths
@@ -1271,14 +1265,14 @@ CONSTRAINT_BOOKED = 0.5
 INSENSITIVE_GROWTH = 1.5
 #: ... only for increments cut below this share of the first (the crawl after a jump). Above it
 #: the plain rule keeps its finer steps where a crack front passes node by node (10-12
-#: iterations at any size there): without the bound the ENF example took 52 instead of 73 steps,
-#: and its sampled peak fell from 721.8 to 715.8 N
+#: iterations at any size there): without the bound the ENF example takes 52 instead of 73 steps,
+#: and its sampled peak falls from 721.8 to 715.8 N
 INSENSITIVE_BELOW = 1.0 / 16.0
 
 
 #: where friction acts, dissipation-controlled increments grow so below this share of the largest
 #: so far: with 1/16 (as INSENSITIVE_BELOW) the lap shear with alpha_T = 1e6 at a quarter of the arc
-#: length held Δτ at 1/5-1/20 of its largest with 10-12 iterations at any size there, 735
+#: length holds Δτ at 1/5-1/20 of its largest with 10-12 iterations at any size there, 735
 #: increments (254 with 1/2; the peaks within 0.03 % of P_u)
 DISSIPATION_INSENSITIVE_BELOW = 0.5
 
@@ -1293,11 +1287,11 @@ def size_insensitive(size: float, its: int, recent: list[tuple[float, int]], tar
     step-size rule (size × target/its) assumes that a shorter increment converges in fewer
     iterations. Where a state that each commit changes sets the count, it does not:
     - load control: the thesis's slip-softening friction relaxing after the Gmsh plate's
-      debonding jump at λ = 0.496 (increments of 10⁻⁵ to 3·10⁻⁴ all took 6-12 iterations, the
-      first residual set by the committed friction, not by Δλ) held Δλ near 10⁻⁵ for 1000
+      debonding jump at λ = 0.496 (increments of 10⁻⁵ to 3·10⁻⁴ all take 6-12 iterations, the
+      first residual set by the committed friction, not by Δλ) would hold Δλ near 10⁻⁵ for 1000
       increments;
     - arc length: the cohesive slab on 16 × 12 (test_slab_trc_soffit.py) from 225 kN/m²,
-      arc lengths of 8·10⁻⁶, 8·10⁻⁵ and 8·10⁻⁴ took 5, 7-9 and 9 iterations (the first
+      arc lengths of 8·10⁻⁶, 8·10⁻⁵ and 8·10⁻⁴ take 5, 7-9 and 9 iterations (the first
       iteration halves the residual, whatever its size, and every other increment's sets change
       once at its solution): 8·10⁻⁵, 1 % of the first, with 0.04 kN/m² per increment. Its
       counts alternate (7, 9, 7, ...), hence the window of two.

@@ -178,31 +178,29 @@ class ConvergenceError(RuntimeError):
 
 #: a contact set that still changes after ``max_active_set_loops`` is accepted where its last
 #: state holds within this traction error (a fraction of the interface strength,
-#: ContactBlock.set_violation): points at ḡ_N ≈ 0 flipping between equivalent states. Before,
-#: any last state was accepted; the Gmsh plate (examples/plate_gmsh.toml) then reported at
-#: λ = 0.875 a state with 8 released points interpenetrating by up to 0.24 mm (2.4 % of the TRC
-#: layer) without a contact force, and at λ = 0.5 points in the set pulled open by 8·10⁻⁹ m,
-#: a tension of 1.3 × σ_max under α_N
+#: ContactBlock.set_violation): points at ḡ_N ≈ 0 flipping between equivalent states. Accepting
+#: any last state would let the Gmsh plate (examples/plate_gmsh.toml) report at λ = 0.875 a state
+#: with 8 released points interpenetrating by up to 0.24 mm (2.4 % of the TRC layer) without a
+#: contact force
 CONTACT_SET_TOL = 1e-3
 
 #: re-freezings of the cohesive sets at the best iterate of a failed frozen solve, per call of :func:`newton`
 MAX_REFREEZE = 3
 #: the stagnation window of frozen cohesive solves in arc-length increments where friction acts
-#: on a damaged share (arclength.stagnation_window): the 8 × 6 TRC slab restarted on its snap-back
-#: at 306.68 kN/m² with the frozen stick state and the reversal limit gave up after 3 iterations
-#: there and went on to 302.76 with 8
+#: on a damaged share (arclength.stagnation_window): stick/slip switches make such solves
+#: stagnate for a few iterations before they converge (the 8 × 6 TRC slab on its snap-back at
+#: 306.68 kN/m² needs more than 3)
 FRICTION_STAGNATION = 8
 #: a frozen cohesive solve whose residual is within this multiple of the tolerance ends there if
 #: the sets no longer hold at its iterate: the active-set loop freezes them again at once
 #: instead of converging a frozen problem that it will discard. The frozen problems are nearly
 #: linear (one iteration takes the residual from 10³ to 10⁻⁶-10⁻⁴ of the load), and their last
-#: iteration, down to the tolerance, was one of the two or three of most loops (the DCB on 200
-#: elements under displacement control: 605 → 521 iterations; by arc length 667 → 626, 575
-#: where friction acting at a few points did not switch it off: docs/performance.md). Only the
+#: iteration, down to the tolerance, is one of the two or three of most loops (the DCB on 200
+#: elements under displacement control: 521 iterations with it, 605 without; docs/performance.md). Only the
 #: loop's last solve, whose sets hold, must converge to the tolerance. Not with friction on the
 #: damaged share: stick and slip are not frozen, so the frozen problem is not smooth, and its
-#: residual says less about how near its solution an iterate is (the lap shear with μ0 = 0.95,
-#: arc length, took an unloading increment before its peak, -3.7 %).
+#: residual says less about how near its solution an iterate is (with early exits the lap shear
+#: with μ0 = 0.95 by arc length takes an unloading increment before its peak, -3.7 %).
 EARLY_REFREEZE = 1e3
 
 
@@ -210,9 +208,9 @@ def early_blocks(problem: Problem, blocks: list) -> list | None:
     """The frozen cohesive ``blocks`` of an active-set loop whose solves may end early
     (:func:`early_refreeze`), or None: only on a linear model (``nonlinear = false``) without
     friction acting on the damaged share, where the frozen problem is smooth and nearly linear.
-    Not on the geometrically nonlinear MITC9 §5.1 plate (12 × 12, μ0 = 0, arc length): near
-    λ = 0.995, where the frozen problems have no solution close by, the early exits changed the
-    sets the loop tried and the path went down a snap-back to λ = 0.647 and up again (66
+    Not on a geometrically nonlinear model: on the MITC9 §5.1 plate (12 × 12, μ0 = 0, arc length)
+    near λ = 0.995, where the frozen problems have no solution close by, early exits change the
+    sets the loop tries and send the path down a snap-back to λ = 0.647 and up again (66
     increments instead of 38, w_front_max 2.5 % larger at λ = 1). Not with friction: see
     :data:`EARLY_REFREEZE`."""
     if not blocks or getattr(problem.model, "nonlinear", True) or friction_acts(blocks):
@@ -257,8 +255,8 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
     moves it (:func:`contact_to_nodes`). A contact set still changing after
     ``max_active_set_loops`` is accepted only within :data:`CONTACT_SET_TOL`.
     Both use the residual line search for contact (full Newton steps in the semi-smooth phase
-    cut the pull-off's time by about 10 % but took 2.5× the iterations in the §5.1 plate's first
-    debonding step and failed there without any line search).
+    save about 10 % of the pull-off's time but take 2.5× the iterations in the §5.1 plate's first
+    debonding step, and fail there without any line search).
 
     Cohesive interfaces (blocks with ``smooth_when_frozen``): no semi-smooth phase (it cycles at
     the kink of the law at the onset of damage); the active-set loop freezes the tension state
@@ -304,7 +302,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         if res.residuals and np.isfinite(res.residuals[-1]) and res.residuals[-1] < res.residuals[0]:
             u = u_new  # go on from the semi-smooth iterate where it got closer
     # with its sets frozen a cohesive interface is smooth but softening: the residual line search
-    # then stalls on the way through a softening point (the DCB's crack tip, issue 13); full steps
+    # then stalls on the way through a softening point (the DCB's crack tip); full steps
     # converge there (contact blocks keep it: it helps at the stick/slip transitions)
     s_frozen = replace(s, line_search=False) if cohesive_only else s
     loop = ActiveSetLoop(blocks, cohesive_only)
@@ -337,7 +335,7 @@ def newton(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings) -> tu
         if not res.converged and cohesive_only and s.line_search and left > 0 and friction_acts(blocks):
             # friction on the damaged share (stick/slip) is not smooth within the frozen sets:
             # full steps can wander there (the §5.1 cohesive plate past its first full debonding
-            # stopped at λ = 1.074 on 12 × 12, with the residual line search it reaches 1.2);
+            # on 12 × 12 stalls at λ = 1.074 with them and reaches 1.2 with the line search);
             # the same solve again from the same start with the line search
             u_new, res = newton_fixed_set(problem, u, lam, replace(s, max_iterations=min(s.max_iterations, left)))
             total.iterations += res.iterations
@@ -462,11 +460,9 @@ def freeze_sets(blocks: list, u: np.ndarray, seen: dict[bytes, int] | None) -> b
     near this increment - a node of a crack front with a local snap-back; the caller fails the
     increment, which is then cut, instead of iterating to ``max_active_set_loops``). The state is
     what the blocks freeze (``frozen_key``): with friction on a cohesive interface its stick
-    state too - counted by the loading sets alone, a loop in which only stick points went over
-    their limits, one or two per solve, repeated its key and 'cycled' after two refreezes (the
-    TRC slab on its snap-back, 8 × 6: 319 of 406 refusals in its first 390 increments; those
-    sampled had kept one key three times, their best states 1.0-7.6·10⁻³ of the strength from
-    consistency, against the tolerance of 10⁻³)."""
+    state too - counted by the loading sets alone, a loop in which only stick points go over
+    their limits, one or two per solve, repeats its key and 'cycles' after two refreezes (on the
+    TRC slab's snap-back, 8 × 6, most refused increments would be such false cycles)."""
     if seen is None:
         for b in blocks:
             b.freeze(u)
@@ -600,7 +596,7 @@ def at_round_off_floor(residuals: list[float], scale: float, en: float, e0: floa
     halved by the last iteration), of the work f·u of the state (``work()``, evaluated only then);
     or its size within ``tol_displacement`` of the displacements. (The work alone would end
     iterations that still converge: with a tolerance of 10⁻¹² the Gmsh plate and its generator
-    twin then differed by 9·10⁻⁸.)"""
+    twin would differ by 9·10⁻⁸.)"""
     rn = residuals[-1]
     if rn > s.tol_floor * scale:
         return False
@@ -810,11 +806,11 @@ RELAX_DT_MAX = 1e4
 RELAX_LAG = 1e-3
 RELAX_MAX_INCREMENTS = 400
 # with unstable = "relax", a frozen cohesive solve gives up after this many iterations in a row
-# without progress (:func:`stagnates`) and the step is cut (or relaxed): the 100-element DCB's
-# frozen solves before a snap cycled with period 4 through all 25 iterations (a solve that
-# converges after its residual first grew took 4 such iterations); the 200-element ENF, which
-# stopped at 99.8 % of its end after 2 994 iterations, reaches it in 878 without a relaxation.
-# Not the default: with it the 150-element DCB stopped at a step that the full solves pass
+# without progress (:func:`stagnates`) and the step is cut (or relaxed): before a snap the
+# 100-element DCB's frozen solves cycle with period 4 through all 25 iterations (a solve that
+# converges after its residual first grew takes 4 such iterations); the 200-element ENF reaches
+# its end in 878 iterations without a relaxation, against 2 994 to 99.8 % of it without the rule.
+# Not the default: with it the 150-element DCB stops at a step that the full solves pass
 FROZEN_STAGNATION = 8
 # load_steps: relax after this many bisections of a step (or after max_bisections, if fewer)
 RELAX_AFTER_CUTS = 4
@@ -1042,9 +1038,9 @@ class PseudoViscosity:
     def tangent(self, Kr):
         """K_r + D/Δt; in K_r's own pattern where it knows it (assembly.ReducedTangent), so that
         the solver keeps its symbolic analysis and upper-triangle map (a new CSR matrix per
-        iteration made the solver repeat its symbolic analysis every other solve, and sort and
-        check the symmetry every solve: four damped increments of the CFRP plate on 24 × 16,
-        16 iterations, took 35.0 s that way against 26.2 s now)."""
+        iteration would make the solver repeat its symbolic analysis every other solve, and sort
+        and check the symmetry every solve: 35.0 s instead of 26.2 s for four damped increments of
+        the CFRP plate on 24 × 16)."""
         import scipy.sparse as sp
 
         rs = getattr(Kr, "scatter", None)
@@ -1102,20 +1098,20 @@ def settle(problem: Problem, u: np.ndarray, lam: float, s: NewtonSettings,
     With small Δt the damped tangent K_r + D/Δt is positive definite even where K_r is not (a
     layer released beyond its buckling load), and the state moves along the energy's descent -
     the snap a structure makes at a fixed load, without the inertia - instead of the jump of a
-    Newton step, which on the CFRP plate on 24 × 16 cycled through the contact sets of a
+    Newton step, which on the CFRP plate on 24 × 16 cycles through the contact sets of a
     buckling sublaminate. An increment counts only where its damped tangent is positive definite
     (else Δt is cut and capped): beyond 1/|μ| of an unstable mode μ implicit Euler damps that
     mode instead of letting it grow and converges onto the saddle (the imperfect column at
-    1.5 P_E ended on its straight state). Once the damping force is below SETTLE_STATIC of the
+    1.5 P_E would end on its straight state). Once the damping force is below SETTLE_STATIC of the
     load and the undamped tangent is positive definite (or its inertia unknown: a friction
     tangent that is not symmetric), the damping is removed and a static Newton solve from there
     (with an increment's budget, then tried again after Δt has grown fourfold) must converge to
     a state with a positive definite tangent: the result is an equilibrium of the undamped
     problem (its residual within ``tol_residual``), not a damped approximation. Where the static
     solves fail, the damped increments go on: their damping force is the static residual of
-    their state, and once it is within ``tol_residual`` a static solve is tried at once (the
-    completely debonded CFRP plate on 24 × 16: static solves from damping forces below 1 % of
-    the load failed, 125 iterations each, while the damped increments converged in 6-7). A
+    their state, and once it is within ``tol_residual`` a static solve is tried at once (on the
+    completely debonded CFRP plate on 24 × 16 static solves from damping forces below 1 % of
+    the load fail, 125 iterations each, while the damped increments converge in 6-7). A
     saddle is left by :func:`push_off_saddle`. The work of the out-of-balance force along the
     path (the energy the snap released: the fall of the potential energy where the structure is
     conservative) and the largest displacement change are recorded in
@@ -1231,7 +1227,7 @@ def contact_hint(problem: Problem) -> str:
     """The end of the message of a failed solve on a model whose thesis-law contact between
     debonded layers acts at the face Gauss points (the default, the thesis's): there the stiff
     penalty's tractions oscillate from point to point, and on refined meshes the contact set can
-    cycle (the §5.1 plate with slip-softening friction on 12 × 12 stopped at λ = 0.375 with a load
+    cycle (the §5.1 plate with slip-softening friction on 12 × 12 stops at λ = 0.375 with a load
     step's budget for its re-solutions; at the nodes it reaches λ = 1 with it, and at the Gauss
     points with :data:`REEQUILIBRATION_BUDGET` in 1884 iterations, against 377 at the
     nodes; tests/test_delamination.py, docs/user-guide.md). Where the contact has moved to the
