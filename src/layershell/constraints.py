@@ -102,6 +102,21 @@ def _vector_constraint(rows: _Rows, src: int, target: np.ndarray, n: np.ndarray,
             rows.dep(dep, c, v / nj, src)
 
 
+def _director_values(fx) -> np.ndarray:
+    """Prescribed values of a fix per (director, component), shape (1, n_dir, n_comp): with director
+    0 among the held ones the value moves it (the layer's reference face) and the other held
+    directors stay zero, a translation of the section; without director 0 each held director takes
+    the value (in its own units)."""
+    dirs = list(fx.directors)
+    val = np.asarray(fx.value, float)
+    out = np.zeros((1, len(dirs), val.size))
+    if 0 in dirs:
+        out[0, dirs.index(0)] = val
+    else:
+        out[0] = val
+    return out
+
+
 def collect(model: Model, dm: DofMap, bonded: dict[int, np.ndarray] | None = None) -> _Rows:
     """All constraint triples of the model for the given bond state (default: fully bonded)."""
     rows = _Rows()
@@ -128,7 +143,7 @@ def collect(model: Model, dm: DofMap, bonded: dict[int, np.ndarray] | None = Non
         if getattr(fx, "value", None) is None:
             rows.fix(sel)
         else:  # prescribed displacement (displacement control), value per component
-            rows.prescribe(sel, np.asarray(fx.value, float)[None, None, :], fx.scaled)
+            rows.prescribe(sel, _director_values(fx), fx.scaled)
     # --- symmetry planes: u_l · n = 0 for every free director vector
     for i, sy in enumerate(model.symmetries):
         src = rows.source(f"symmetry plane {i + 1}")
@@ -185,18 +200,43 @@ def collect(model: Model, dm: DofMap, bonded: dict[int, np.ndarray] | None = Non
 
 
 def build_operator(n_full: int, rows: _Rows) -> ConstraintOperator:
-    """Resolve the dependency triples into T (chains such as multi-layer bonds are substituted)."""
+    """Resolve the dependency triples into T (chains such as multi-layer bonds are substituted).
+
+    A support on a DOF that a relation already defines (the reference face of a bonded upper
+    layer, a DOF on an oblique symmetry plane or a hinge) keeps that relation: the support becomes
+    a row "u_d = value" written in the independent DOFs (:func:`impose_rows`), so the bond holds
+    and the support acts on the DOFs the relation refers to."""
     r = rows.cat(rows.rows, np.int64)
     c = rows.cat(rows.cols, np.int64)
     v = rows.cat(rows.vals, float)
+    src = rows.cat(rows.srcs, np.int64)
     fixed = np.unique(rows.cat(rows.fixed, np.int64))
-    is_fixed = np.zeros(n_full, bool)
-    is_fixed[fixed] = True
-    keep = ~is_fixed[r]  # a fixed DOF is zero whatever else is said of it
-    src = rows.cat(rows.srcs, np.int64)[keep]
-    r, c, v = r[keep], c[keep], v[keep]
-    dep_rows = np.unique(r)
-    # every dependent DOF must be defined by exactly one relation (one source)
+    _check_single_source(rows, r, src)
+    is_dep = np.zeros(n_full, bool)
+    is_dep[r] = True
+    plain = fixed[~is_dep[fixed]]  # fixed DOFs no relation defines: removed from the unknowns
+    held = fixed[is_dep[fixed]]  # fixed DOFs a relation defines: imposed as rows below
+    is_out = is_dep.copy()
+    is_out[plain] = True
+    indep = np.flatnonzero(~is_out)
+    n_red = indep.size
+    S = sp.csr_matrix((np.ones(n_red), (indep, np.arange(n_red))), shape=(n_full, n_red))
+    D = sp.csr_matrix((v, (r, c)), shape=(n_full, n_full))
+    T = _resolve_chain(S, D)
+    v_s, v_c = _prescribed_values(n_full, rows)
+    on_plain = np.zeros(n_full, bool)
+    on_plain[plain] = True
+    g_s, g_c = (_resolve_vector(np.where(on_plain, vv, 0.0), D) for vv in (v_s, v_c))
+    pres = np.unique(np.concatenate([d[val != 0] for d, val, _ in rows.values])) if rows.values else None
+    op = ConstraintOperator(T, indep, fixed, g_s, g_c, pres if pres is not None and pres.size else None)
+    if held.size:
+        C = sp.csr_matrix((np.ones(held.size), (np.arange(held.size), held)), shape=(held.size, n_full))
+        op = impose_rows(op, C, v_s[held], v_c[held])
+    return _without_zero_vectors(op)
+
+
+def _check_single_source(rows: _Rows, r: np.ndarray, src: np.ndarray) -> None:
+    """Every dependent DOF must be defined by exactly one relation (one source)."""
     pairs = np.unique(np.stack([r, src], 1), axis=0) if r.size else np.zeros((0, 2), np.int64)
     rr, cnt = np.unique(pairs[:, 0], return_counts=True)
     if np.any(cnt > 1):
@@ -206,12 +246,10 @@ def build_operator(n_full: int, rows: _Rows) -> ConstraintOperator:
             f"{int((cnt > 1).sum())} DOF(s) are constrained twice (first: full DOF {bad}, by "
             f"{' and '.join(names)}); remove one of the overlapping supports, or use a fix instead"
         )
-    is_dep = np.zeros(n_full, bool)
-    is_dep[dep_rows] = True
-    indep = np.flatnonzero(~is_dep & ~is_fixed)
-    n_red = indep.size
-    S = sp.csr_matrix((np.ones(n_red), (indep, np.arange(n_red))), shape=(n_full, n_red))
-    D = sp.csr_matrix((v, (r, c)), shape=(n_full, n_full))
+
+
+def _resolve_chain(S: sp.csr_matrix, D: sp.csr_matrix) -> sp.csr_matrix:
+    """T = S + D T by substitution (a dependent DOF may refer to dependent DOFs: bond chains)."""
     T = S
     for _ in range(64):
         Tn = (S + D @ T).tocsr()
@@ -223,48 +261,125 @@ def build_operator(n_full: int, rows: _Rows) -> ConstraintOperator:
     else:
         raise ConstraintError("constraints refer to each other in a cycle; check supports, hinges and bonds")
     T.sort_indices()
-    g_s, g_c, pres = _prescribed(n_full, rows, D)
-    return ConstraintOperator(T, indep, fixed, g_s, g_c, pres)
+    return T
 
 
-def _prescribed(n_full: int, rows: _Rows, D: sp.csr_matrix):
-    """Prescribed displacement vectors (scaled, constant) with the dependent DOFs that refer to
-    prescribed ones (g = g_p + D g, resolved like T), and the prescribed DOFs; Nones without."""
-    if not rows.values:
-        return None, None, None
-    out = []
+def _resolve_vector(gp: np.ndarray, D: sp.csr_matrix) -> np.ndarray:
+    """g = g_p + D g: prescribed values carried to the DOFs that depend on them."""
+    g = gp.copy()
+    for _ in range(64):
+        gn = gp + D @ g
+        if np.allclose(gn, g, rtol=0.0, atol=1e-14 * max(1.0, np.abs(gn).max())):
+            return gn
+        g = gn
+    raise ConstraintError("constraints refer to each other in a cycle; check supports, hinges and bonds")
+
+
+def _prescribed_values(n_full: int, rows: _Rows) -> tuple[np.ndarray, np.ndarray]:
+    """Per full DOF the prescribed value (× λ, constant); zero at homogeneous supports."""
+    out = {True: np.zeros(n_full), False: np.zeros(n_full)}
     seen = np.full(n_full, np.nan)
-    for want in (True, False):
-        g = np.zeros(n_full)
-        for d, v, scaled in rows.values:
-            if scaled != want:
-                continue
-            clash = ~np.isnan(seen[d]) & ~np.isclose(seen[d], v)
-            if clash.any():
-                raise ConstraintError(f"a DOF (full DOF {d[clash][0]}) has two different prescribed displacements; "
-                                      "give each support component one value (remove the overlap)")
-            seen[d] = v
-            g[d] = v
-        gp = g.copy()
-        for _ in range(64):
-            gn = gp + D @ g
-            if np.allclose(gn, g, rtol=0.0, atol=1e-14 * max(1.0, np.abs(gn).max())):
-                g = gn
-                break
-            g = gn
-        out.append(g if np.any(g) else None)
-    pres = np.unique(np.concatenate([d[v != 0] for d, v, _ in rows.values]))
-    return out[0], out[1], pres
+    for d, v, scaled in rows.values:
+        clash = ~np.isnan(seen[d]) & ~np.isclose(seen[d], v)
+        if clash.any():
+            raise ConstraintError(f"a DOF (full DOF {d[clash][0]}) has two different prescribed displacements; "
+                                  "give each support component one value (remove the overlap)")
+        seen[d] = v
+        out[scaled][d] = v
+    return out[True], out[False]
+
+
+def _without_zero_vectors(op: ConstraintOperator) -> ConstraintOperator:
+    """None for prescribed vectors that are zero (the operator of a model without displacement
+    control), and the prescribed DOFs set whenever one of them is not."""
+    g_s = op.g_scaled if op.g_scaled is not None and np.any(op.g_scaled) else None
+    g_c = op.g_const if op.g_const is not None and np.any(op.g_const) else None
+    pres = op.prescribed
+    if g_s is None and g_c is None:
+        pres = None
+    elif pres is None:
+        pres = np.flatnonzero((g_s if g_s is not None else 0.0) + np.abs(g_c if g_c is not None else 0.0))
+    return ConstraintOperator(op.T, op.independent, op.fixed, g_s, g_c, pres)
+
+
+def impose_rows(op: ConstraintOperator, C: sp.csr_matrix, v_s: np.ndarray, v_c: np.ndarray,
+                ) -> ConstraintOperator:
+    """Impose the rows C u = λ v_s + v_c on ``op``'s map u = T u_r + λ g_s + g_c.
+
+    In the independent DOFs a row reads C_r u_r = r with C_r = C T and r = λ (v_s − C g_s) +
+    v_c − C g_c (so a bond, hinge or earlier support is respected). Each row eliminates one
+    independent DOF, its pivot p: u_p = (r − Σ_{j≠p} C_r,j u_j) / C_r,p. A batch of rows is
+    eliminated at once where no row touches another row's pivot; the others wait for the next
+    pass, on the updated map. A row left without coefficients is already satisfied (a redundant
+    support) or contradicts another support (:class:`ConstraintError`)."""
+    T, indep = op.T, op.independent
+    n_full = T.shape[0]
+    g_s = np.zeros(n_full) if op.g_scaled is None else op.g_scaled.copy()
+    g_c = np.zeros(n_full) if op.g_const is None else op.g_const.copy()
+    tol = 1e-9 * max(np.abs(v_s).max(initial=0.0), np.abs(v_c).max(initial=0.0), np.abs(g_s).max(),
+                     np.abs(g_c).max(), 1e-300)
+    scale_c = np.asarray(abs(C).max(axis=1).todense()).ravel()
+    todo = np.arange(C.shape[0])
+    while todo.size:
+        Cs = C[todo]
+        Cr = (Cs @ T).tocsr()
+        Cr.eliminate_zeros()
+        r_s, r_c = v_s[todo] - Cs @ g_s, v_c[todo] - Cs @ g_c
+        live = np.asarray(abs(Cr).max(axis=1).todense()).ravel() > 1e-12 * scale_c[todo]
+        if np.any(~live & ((np.abs(r_s) > tol) | (np.abs(r_c) > tol))):
+            raise ConstraintError(
+                "two supports prescribe different displacements at the same point (or a support contradicts a "
+                "bond, hinge or symmetry plane there); give the point one value, or remove one of the supports")
+        todo, Cr, r_s, r_c = todo[live], Cr[np.flatnonzero(live)], r_s[live], r_c[live]
+        if not todo.size:
+            break
+        now, piv = _independent_pivots(Cr)
+        pv = np.asarray(Cr[now, piv]).ravel()
+        S = sp.diags(1.0 / pv) @ Cr[now]  # rows: u_p + Σ_j S_j u_j = r / C_r,p
+        n_red = T.shape[1]
+        h_s, h_c = np.zeros(n_red), np.zeros(n_red)
+        h_s[piv], h_c[piv] = r_s[now] / pv, r_c[now] / pv
+        g_s, g_c = g_s + T @ h_s, g_c + T @ h_c
+        P = sp.csr_matrix((np.ones(piv.size), (piv, np.arange(piv.size))), shape=(n_red, piv.size))
+        E = sp.identity(n_red, format="csr") - P @ S
+        keep = np.ones(n_red, bool)
+        keep[piv] = False
+        T = (T @ E).tocsr()[:, np.flatnonzero(keep)]
+        T.eliminate_zeros()
+        T.sort_indices()
+        indep = indep[keep]
+        rest = np.ones(todo.size, bool)
+        rest[now] = False
+        todo = todo[rest]
+    pres = op.prescribed
+    extra = np.unique(C[np.flatnonzero((v_s != 0) | (v_c != 0))].indices)
+    if extra.size:
+        pres = extra if pres is None else np.union1d(pres, extra)
+    return _without_zero_vectors(ConstraintOperator(T.tocsr(), indep, op.fixed, g_s, g_c, pres))
+
+
+def _independent_pivots(Cr: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    """Rows of ``Cr`` that can be eliminated together and their pivot columns: each row's
+    largest coefficient among the columns no other row touches (at least 1/10 of the row's
+    largest, for a well-conditioned division); at least the first row with its largest."""
+    A = abs(Cr).tocsr()
+    rowmax = np.asarray(A.max(axis=1).todense()).ravel()
+    count = np.bincount(A.indices, minlength=A.shape[1])
+    row_of = np.repeat(np.arange(A.shape[0]), np.diff(A.indptr))
+    ok = (count[A.indices] == 1) & (A.data >= 0.1 * rowmax[row_of])
+    M = sp.csr_matrix((np.where(ok, A.data, 0.0), A.indices, A.indptr), shape=A.shape)
+    best = np.asarray(M.max(axis=1).todense()).ravel()
+    now = np.flatnonzero(best > 0)
+    if now.size:
+        return now, np.asarray(M[now].argmax(axis=1)).ravel()
+    return np.array([0]), np.asarray(A[0].argmax(axis=1)).ravel()
 
 
 def apply_ties(op: ConstraintOperator, model: Model, dm: DofMap) -> ConstraintOperator:
-    """Supports on a face, at a height or on a director of any layer (:class:`~layershell.model.Tie`):
-    each row c·u = 0 is written in the reduced DOFs of ``op`` (c_r = c T, so a bond or hinge is
-    respected) and the reduced DOF with the largest |c_r| is eliminated, u_p = -Σ c_r,j/c_r,p u_j.
-    Rows of one tie and component belong to distinct nodes and so to distinct reduced DOFs
-    (all relations are node-local), which lets a whole batch be eliminated at once; a row that
-    is already satisfied (c_r = 0, e.g. on a fixed DOF) is skipped."""
-    T, indep = op.T, op.independent
+    """Supports on a face, at a height, in a direction or through all layers
+    (:class:`~layershell.model.Tie`): per node Σ_l c_l u_l · e = λ v (× λ when the tie is
+    scaled; v = 0 without a value), imposed on ``op`` by :func:`impose_rows` (so a bond or hinge
+    is respected)."""
     for tie in model.ties:
         present = dm.present[tie.layer][tie.nodes]
         nodes, coeffs, dirs = tie.nodes[present], tie.coeffs[present], tie.direction[present]
@@ -274,31 +389,12 @@ def apply_ties(op: ConstraintOperator, model: Model, dm: DofMap) -> ConstraintOp
         m = nodes.size
         rows = np.repeat(np.arange(m), D.shape[1] * 3)
         vals = (coeffs[:, :, None] * dirs[:, None, :]).ravel()
-        C = sp.csr_matrix((vals, (rows, D.ravel())), shape=(m, T.shape[0]))
-        Cr = (C @ T).tocsr()
-        Cr.eliminate_zeros()
-        scale = np.abs(vals).reshape(m, -1).max(1)
-        A = abs(Cr)
-        piv = np.asarray(A.argmax(axis=1)).ravel()
-        pv = np.asarray(Cr[np.arange(m), piv]).ravel()
-        ok = np.abs(pv) > 1e-12 * scale
-        if not ok.any():
-            continue
-        Cr, piv, pv = Cr[np.flatnonzero(ok)], piv[ok], pv[ok]
-        if np.unique(piv).size != piv.size:
-            raise ConstraintError("two supports of one table act on the same degree of freedom; select each node "
-                                  "once")
-        S = sp.diags(1.0 / pv) @ Cr  # rows: u_p + Σ_j S_j u_j = 0
-        n_red = T.shape[1]
-        P = sp.csr_matrix((np.ones(piv.size), (piv, np.arange(piv.size))), shape=(n_red, piv.size))
-        E = sp.identity(n_red, format="csr") - P @ S
-        keep = np.ones(n_red, bool)
-        keep[piv] = False
-        T = (T @ E).tocsr()[:, np.flatnonzero(keep)]
-        T.eliminate_zeros()
-        T.sort_indices()
-        indep = indep[keep]
-    return ConstraintOperator(T.tocsr(), indep, op.fixed)
+        C = sp.csr_matrix((vals, (rows, D.ravel())), shape=(m, op.T.shape[0]))
+        C.eliminate_zeros()
+        value = np.zeros(m) if tie.value is None else np.asarray(tie.value, float)[present]
+        zero = np.zeros(m)
+        op = impose_rows(op, C, value if tie.scaled else zero, zero if tie.scaled else value)
+    return op
 
 
 def constraint_operator(model: Model, dm: DofMap, bonded=None) -> ConstraintOperator:

@@ -42,7 +42,7 @@ class Fix:
 
 @dataclass(frozen=True)
 class Tie:
-    """Linear support of layer ``layer`` at ``nodes``: Σ_l c_l u_l · n = 0 per node, with
+    """Linear support of layer ``layer`` at ``nodes``: Σ_l c_l u_l · n = v per node, with
     ``coeffs (n_sel, d+1)`` (a face or height Θ_L³: c_l = (Θ_L³)^l, MODEL.md §2; one director:
     a unit vector) and unit ``direction (n_sel, 3)``. Applied after the bond, so a support on
     the bottom face of a bonded upper layer acts on the top face of the layer below."""
@@ -51,6 +51,8 @@ class Tie:
     layer: int
     coeffs: np.ndarray
     direction: np.ndarray
+    value: np.ndarray | None = None  # (n_sel,) prescribed Σ_l c_l u_l · n (None: zero)
+    scaled: bool = True  # value × load factor (displacement control)
 
 
 @dataclass(frozen=True)

@@ -302,9 +302,13 @@ class FixDef(Strict):
     direction: Vec3 | None = Field(
         None, description="held direction (global vector, e.g. [0, 0, 1] for a bearing); instead of 'components'")
     value: list[FiniteFloat] | None = Field(
-        None, description="prescribed displacement instead of zero: one value per entry of 'components' (length "
-                          "units; for directors 1.. the director's units), multiplied by the load factor λ when "
-                          "'scaled' (displacement control); the reaction there is f_int − F_ext")
+        None, description="prescribed displacement instead of zero: one value per entry of 'components' (or one "
+                          "for 'direction'; length units), multiplied by the load factor λ when 'scaled' "
+                          "(displacement control); the reaction there is f_int − F_ext. It moves the held point "
+                          "(the face, the height, or director 0); with 'directors' the other held directors stay "
+                          "zero (the section translates); without director 0 in 'directors' each held director "
+                          "takes the value in its own units. On a bonded layer's face it moves the neighbour's "
+                          "face too")
     scaled: bool = Field(True, description="with 'value': multiplied by the load factor λ (false: constant)")
 
 
