@@ -128,3 +128,85 @@ def test_user_guide_refers_to_existing_files():
     for png in ("deformed.png", "load_displacement.png", "load_debonded_area.png", "thickness_",
                 "load_displacement_", "debonded_zone_"):
         assert png in guide and png in plots, png
+
+
+# ----------------------------------------------------------------------------- documents state what holds now
+#: README is a front page; the details live in docs/
+README_MAX_LINES = 200
+_MONTH = r"(?:Jan|Feb|Mar|Apr|May|Jun|Jul|Aug|Sep|Oct|Nov|Dec)[a-z]*\.?"
+#: history that belongs in git log, not in a document: dated entries (26 Nov 2026, 2026-11-30,
+#: Nov 2026, 29-30 Nov, 20:32 UTC), accounts of sessions and issues, before/after logs.
+#: Legitimate years need no month: citations such as "(Teng et al. 2003)" or "Williams 1989",
+#: and library versions such as "MKL 2026.2", pass.
+HISTORY = {
+    "a dated entry": re.compile(rf"\b\d{{1,2}}(?:-\d{{1,2}})? {_MONTH}(?: (?:19|20)\d\d)?\b"),
+    "an ISO date": re.compile(r"\b(?:19|20)\d\d-[01]\d-[0-3]\d\b"),
+    "a month and year": re.compile(rf"\b{_MONTH} (?:19|20)\d\d\b"),
+    "a time of day of a run": re.compile(r"\b\d{1,2}:\d\d UTC\b"),
+    "a session": re.compile(r"\bsessions?\b", re.I),
+    "an issue number": re.compile(r"\bissues? #?\d+", re.I),
+    "a before/after log": re.compile(r"\bbefore:", re.I),
+}
+
+
+def history_in(text: str) -> list[str]:
+    """The lines of ``text`` that retell history, each with what was found."""
+    return [f"{i}: {what}: {line.strip()[:120]}" for i, line in enumerate(text.splitlines(), 1)
+            for what, pattern in HISTORY.items() if pattern.search(line)]
+
+
+def example_header(path: Path) -> str:
+    """What an example says about itself: its comment lines (TOML, Gmsh .geo, Python) and a Python
+    file's module docstring."""
+    text = path.read_text(encoding="utf-8")
+    marker = "//" if path.suffix == ".geo" else "#"
+    lines = [line for line in text.splitlines() if line.lstrip().startswith(marker)]
+    if path.suffix == ".py":
+        import ast
+
+        lines.append(ast.get_docstring(ast.parse(text)) or "")
+    return "\n".join(lines)
+
+
+def local_links(markdown: str) -> list[str]:
+    """Targets of the Markdown links that point into the repository (no URL, no bare anchor)."""
+    targets = re.findall(r"\]\(([^)\s]+)\)", markdown)
+    return [t.split("#")[0] for t in targets if not re.match(r"[a-z]+:|#", t)]
+
+
+def test_the_history_detector_flags_history_and_passes_citations():
+    flagged = ["measured on 26 Nov 2026", "re-measured 2026-11-24", "in Nov 2026", "the run of 29-30 Nov",
+               "at 20:32 UTC after 75 minutes", "the twelfth session", "(issue 13)", "Issue 6, benchmark 4",
+               "before: 85 s"]
+    for line in flagged:
+        assert history_in(line), line
+    for line in ["(Teng et al. 2003)", "Williams 1989; Wang & Williams 1992", "MKL 2026.2, numpy 2.4.6",
+                 "fib Model Code 2010 (5.1-9)", "the 3 × 3 face Gauss points", "before the run starts"]:
+        assert not history_in(line), (line, history_in(line))
+
+
+def test_readme_is_a_front_page():
+    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    n = len(text.splitlines())
+    assert n <= README_MAX_LINES, f"README.md has {n} lines: move details to docs/ (at most {README_MAX_LINES})"
+
+
+def test_readme_links_to_files_that_exist():
+    links = local_links((ROOT / "README.md").read_text(encoding="utf-8"))
+    assert "docs/limits.md" in links and "docs/user-guide.md" in links
+    missing = [t for t in links if not (ROOT / t).exists()]
+    assert not missing, f"README.md links to files that do not exist: {missing}"
+
+
+def test_documents_and_example_headers_state_no_history():
+    """README.md, docs/*.md and the examples' headers say what holds now; the history of a result
+    (when it was measured, in which session, for which issue, what it was before) is in git log."""
+    found = {}
+    for path in [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]:
+        found[path.relative_to(ROOT)] = history_in(path.read_text(encoding="utf-8"))
+    for path in sorted((ROOT / "examples").iterdir()):
+        if path.suffix in (".toml", ".py", ".geo"):
+            found[path.relative_to(ROOT)] = history_in(example_header(path))
+    found = {str(k): v for k, v in found.items() if v}
+    assert not found, "state what holds now; history belongs in git log:\n" + "\n".join(
+        f"{k}:{line}" for k, v in found.items() for line in v)
