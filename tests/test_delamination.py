@@ -116,7 +116,7 @@ def test_cantilever_plate_friction_laws():
     instead of reaching mid-plate, and the slip case's softening limit (4.76) has fallen to about
     1 % of τ_max (slips up to 0.5 mm = 10 g_T^μ), like the weak law's 0.01 τ_Delam. On 6 × 6
     elements the zone reaches mid-plate and weak gives 0.06704 (+1.0 %), but onset drops to
-    λ = 0.21 (mesh-dependent stress criterion, README "Known limits").
+    λ = 0.21 (mesh-dependent stress criterion, docs/limits.md).
 
     The contact between debonded layers acts at the face Gauss points, as in the thesis
     (rule = "gauss"; the strong and slip cases settle one re-solution at λ = 0.542). With the

@@ -6,7 +6,7 @@ the next equilibrium (solver/newton.py ``relax``), and the energy the jump relea
 The case: the DCB of examples/dcb_cohesive.toml on 100 elements, opened by prescribed
 displacements (tests/test_dcb.py DISPLACEMENT_CONTROL). Its process zone spans 2.45 node
 spacings; without relaxation the run stops at λ = 0.5194 (δ = 5.19 mm), after the peak, where
-the front jumps an element (measured; README, known limits)."""
+the front jumps an element (measured; docs/limits.md)."""
 import numpy as np
 import pytest
 
