@@ -581,6 +581,53 @@ def _heights(model: Model, nodes: np.ndarray, height: float | None, face: str | 
     return out
 
 
+def _downward_face_note(m: meshmod.Mesh, nodes: np.ndarray, face: str, f: str) -> list[str]:
+    """'bottom' and 'top' count along the normal A3 (Θ³); where A3 points down they are the
+    physical top and bottom: say so, since a bearing then sits on the other side."""
+    if face not in ("bottom", "top") or not np.all(nodal_normals(m)[nodes, 2] < -0.5):
+        return []
+    other = "top" if face == "bottom" else "bottom"
+    where = "upper" if face == "bottom" else "lower"
+    return [f"'{f}.face' = '{face}' is the face at Θ³ = {'0' if face == 'bottom' else 'H'} of the layer, counted "
+            f"along the normal A3, which points down (−z) at these nodes: it is the physically {where} face. For "
+            f"the other side write face = '{other}'"]
+
+
+def _present_at(model: Model, k: int, nodes: np.ndarray) -> np.ndarray:
+    """Whether layer ``k`` exists at each node (an element of a stack with that layer touches it)."""
+    on = np.zeros(model.mesh.n_nodes, bool)
+    for si, st in enumerate(model.stacks):
+        if k in st:
+            on[np.unique(model.mesh.elements[model.element_stack == si])] = True
+    return on[nodes]
+
+
+def _default_layer(model: Model, nodes: np.ndarray, first: int) -> int:
+    """The layer a support without 'layer' holds: the first stack's bottom layer where it exists at
+    every selected node, else the lowest layer that does (the layer at the reference face there)."""
+    if _present_at(model, first, nodes).all():
+        return first
+    here = [j for j in range(len(model.layers)) if _present_at(model, j, nodes).all()]
+    return min(here, key=lambda j: model.offset(j)[nodes].mean()) if here else first
+
+
+def _require_present(model: Model, k: int, nodes: np.ndarray, f: str) -> None:
+    """A support on layer ``k`` must select nodes where that layer exists: elsewhere it would
+    hold nothing."""
+    here = _present_at(model, k, nodes)
+    if here.all():
+        return
+    name = model.layers[k].name
+    bad = nodes[~here]
+    x = model.mesh.nodes[bad[0]]
+    there = [model.layers[j].name for j in range(len(model.layers)) if _present_at(model, j, bad[:1])[0]]
+    raise InputError(
+        f"'{f}': layer '{name}' does not exist at {bad.size} of the {nodes.size} selected node(s) (first at "
+        f"({x[0]:g}, {x[1]:g}, {x[2]:g}); '[[stacks]]' leaves it out there), so the support would hold nothing "
+        f"there. Select only nodes where '{name}' exists, or name a layer present there ('layer' = "
+        f"{' or '.join(repr(t) for t in there) or 'none'}; 'all' holds every layer present)")
+
+
 def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) -> list[Tie]:
     """A fix on a face, at a height, in a direction or through all layers (``layer = 'all'``) as
     linear supports Σ_l c_l u_l · e = 0 (see :func:`layershell.constraints.apply_ties`)."""
@@ -593,6 +640,7 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
         if not sd.components:
             raise InputError(f"'{f}.components': give at least one of 'x', 'y', 'z' (or a 'direction')")
         dirs = [np.eye(3)["xyz".index(c)] for c in dict.fromkeys(sd.components)]
+    values = _tie_values(sd, f, len(dirs))
     placed = sd.face is not None or sd.height is not None
     if placed and sd.directors != [0]:
         raise InputError(f"'{f}.directors': a support on a face or at a height holds the displacement there; "
@@ -612,7 +660,9 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
             for l in dirs_k:
                 c = np.zeros((nodes.size, ly.directors + 1))
                 c[:, l] = 1.0
-                out += [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for e in dirs]
+                moved = values is not None and (l == 0 or 0 not in dirs_k)  # as a fix: the section translates
+                out += [Tie(nodes, k, c, np.tile(e, (nodes.size, 1)), _tie_value(values, j, nodes.size, moved),
+                            sd.scaled) for j, e in enumerate(dirs)]
         return out
     if sd.layer is not None and sd.layer not in index:
         raise InputError(f"'{f}.layer': unknown layer '{sd.layer}'; defined: {list(index)} (or 'all')")
@@ -621,7 +671,8 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
         h = float(sd.height)
         if k is None:  # the layer containing the height at the nodes (the upper one at an interface)
             cands = [j for j in range(len(layers))
-                     if np.all((model.offset(j)[nodes] <= h + 1e-9 * model.mesh.size())
+                     if _present_at(model, j, nodes).all()
+                     and np.all((model.offset(j)[nodes] <= h + 1e-9 * model.mesh.size())
                                & (h <= (model.offset(j) + layers[j].thickness)[nodes] + 1e-9 * model.mesh.size()))]
             if not cands:
                 raise InputError(f"'{f}.height': no layer contains Θ³ = {h:g} at all selected nodes (total thickness "
@@ -629,27 +680,49 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
                                  f"{model.total_thickness()[nodes].max():.6g}); give a height inside the shell or "
                                  "name the 'layer'")
             k = max(cands, key=lambda j: model.offset(j)[nodes].mean())
+        _require_present(model, k, nodes, f)
         theta = h - model.offset(k)[nodes]
         H = layers[k].thickness[nodes]
         if np.any(theta < -1e-9 * model.mesh.size()) or np.any(theta > H + 1e-9 * model.mesh.size()):
             raise InputError(f"'{f}.height': Θ³ = {h:g} lies outside layer '{layers[k].name}' at some selected nodes; "
                              "give a height inside the layer or leave 'layer' out")
     else:
-        k = first if k is None else k
+        k = _default_layer(model, nodes, first) if k is None else k
+        _require_present(model, k, nodes, f)
         theta = (layers[k].thickness[nodes] if sd.face == "top" else np.zeros(nodes.size))
     if sd.directors != [0] and not placed:
         d = layers[k].directors
         dl = range(d + 1) if sd.directors == "all" else sd.directors
         if any(l > d or l < 0 for l in dl):
             raise InputError(f"'{f}.directors': layer '{layers[k].name}' has directors 0..{d}, got {list(dl)}")
-        cs = []
+        cs, moved = [], []
         for l in dl:
             c = np.zeros((nodes.size, d + 1))
             c[:, l] = 1.0
             cs.append(c)
+            moved.append(values is not None and (l == 0 or 0 not in dl))
     else:
-        cs = [theta[:, None] ** np.arange(layers[k].directors + 1)]
-    return [Tie(nodes, k, c, np.tile(e, (nodes.size, 1))) for c in cs for e in dirs]
+        cs, moved = [theta[:, None] ** np.arange(layers[k].directors + 1)], [values is not None]
+    return [Tie(nodes, k, c, np.tile(e, (nodes.size, 1)), _tie_value(values, j, nodes.size, mv), sd.scaled)
+            for c, mv in zip(cs, moved) for j, e in enumerate(dirs)]
+
+
+def _tie_values(sd, f: str, n_dirs: int) -> list[float] | None:
+    """The prescribed values of a linear support: one per held direction, or None."""
+    if sd.value is None:
+        return None
+    if len(sd.value) != n_dirs:
+        what = "'direction' (one value)" if sd.direction is not None else f"'components' ({n_dirs})"
+        raise InputError(f"'{f}.value': give one prescribed displacement per entry of {what}, got "
+                         f"{len(sd.value)}")
+    return [float(x) for x in sd.value]
+
+
+def _tie_value(values: list[float] | None, j: int, n: int, moved: bool) -> np.ndarray | None:
+    """Per node the prescribed value of held direction ``j`` (None: zero, a plain support)."""
+    if values is None or not moved or values[j] == 0.0:
+        return None
+    return np.full(n, values[j])
 
 
 def _cohesive_law(idf, f: str, gT: float, model, upper: int, lower: int):
@@ -892,15 +965,19 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         raise InputError("'supports': the model has no supports, so it can move as a rigid body; supports must "
                          "prevent every rigid-body motion (3 translations and 3 rotations): add [[supports]] "
                          "tables (type = 'fix', 'symmetry' or 'hinge'), see examples/")
+    face_notes = []
     for i, sd in enumerate(mf.supports):
         f = f"supports[{i}]"
         nodes = _node_selection(m, sd, f)
+        if getattr(sd, "face", None) is not None:
+            face_notes += _downward_face_note(m, nodes, sd.face, f)
         if sd.type == "fix" and (sd.layer == "all" and "all" not in index or sd.face is not None
                                  or sd.height is not None or sd.direction is not None):
             model.ties.extend(_ties(model, sd, nodes, f, index, first))
         elif sd.type == "fix":
             k = layer_idx(sd.layer, f + ".layer")
-            k = first if k is None else k
+            k = _default_layer(model, nodes, first) if k is None else k
+            _require_present(model, k, nodes, f)
             d = layers[k].directors
             dirs = tuple(range(d + 1)) if sd.directors == "all" else tuple(sd.directors)
             if any(l > d or l < 0 for l in dirs):
@@ -1002,7 +1079,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                 raise InputError(f"'{f}.director': layer '{layers[k].name}' has directors 0..{layers[k].directors}")
             model.nodal_loads.append(NodalLoad(nodes, k, ld.director, np.asarray(ld.value, float), ld.scaled))
 
-    notes = []
+    notes = face_notes
     # prescribed displacements (a fix with a non-zero 'value') load the model as well
     moved = any(getattr(sd, "value", None) and any(v != 0 for v in sd.value) for sd in mf.supports)
     if not moved and not mf.loads:

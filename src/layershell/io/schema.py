@@ -295,7 +295,9 @@ class FixDef(Strict):
     face: Literal["bottom", "top"] | None = Field(
         None, description="the support acts on this face of 'layer' (Σ_l (Θ_L³)^l u_l · e = 0; a bonded face "
                           "is shared with the neighbour layer), e.g. layer = 'concrete', face = 'bottom' for a "
-                          "bearing under the concrete while another layer lies below it")
+                          "bearing under the concrete while another layer lies below it. 'bottom' is the face at "
+                          "Θ³ = 0, 'top' at Θ³ = H: counted along the normal, so with [mesh] normal = '-z' "
+                          "'bottom' is the physical top (a warning says so)")
     height: float | None = Field(
         None, description="Θ³ (from the reference face, length) at which the support acts, inside 'layer' (default: "
                           "the layer containing it; at an interface the upper one)")
