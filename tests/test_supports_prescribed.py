@@ -267,3 +267,16 @@ def test_a_support_without_layer_holds_the_layer_present_there():
     spec = build(parse(STACKED.format(support='components = ["z"]'), "stacked.toml"), ".")
     fx = [f for f in spec.model.fixes if 0.0 in spec.model.mesh.nodes[f.nodes, 0]]
     assert [spec.model.layers[f.layer].name for f in fx] == ["core"]
+
+
+@pytest.mark.parametrize("normal, face, warned", [("-z", "bottom", True), ("-z", "top", True),
+                                                   ("+z", "bottom", False), ("+z", "top", False)])
+def test_a_face_support_under_a_downward_normal_says_which_side_it_is(normal, face, warned):
+    """'bottom'/'top' count along Θ³: with normal = "-z" they are the physical top/bottom."""
+    text = STRIP.format(pull=f'layer = "upper"\nface = "{face}"\ncomponents = ["x"]\nvalue = [1.0]', z0=0.5,
+                        clamp=CLAMP_ALL, nx=4, d=1).replace('ny = 1\n', f'ny = 1\nnormal = "{normal}"\n', 1)
+    spec = build(parse(text, "strip.toml"), ".")
+    notes = [w for w in spec.warnings if "supports[1].face" in w]
+    assert bool(notes) == warned
+    if warned:
+        assert "physically " + ("upper" if face == "bottom" else "lower") in notes[0]
