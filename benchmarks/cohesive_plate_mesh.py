@@ -1,4 +1,4 @@
-"""Mesh study of the §5.1 plate with a cohesive interface (issue 13): runs
+"""Mesh study of the §5.1 plate with a cohesive interface: runs
 examples/cantilever_plate_cohesive.toml (and, with --thesis, cantilever_plate_strong.toml, the
 thesis's law) on the meshes given and prints first damage / first full debonding / w_front_max.
 

@@ -1,4 +1,4 @@
-"""Mesh study of the slab with a cohesive soffit layer (issue 13; docs/user-guide.md "A slab with
+"""Mesh study of the slab with a cohesive soffit layer (docs/user-guide.md "A slab with
 a cohesive soffit layer"): examples/slab_trc_soffit.toml with the cohesive law of
 tests/test_slab_trc_soffit.py (G_Ic = 0.14, G_IIc = 0.50 kN/m, η = 2) on the meshes given
 (nx × ny, the example's 8 × 6 grading), printing first damage, w_mid and the fracture energy at

@@ -1,5 +1,5 @@
 """DCB (mode I, examples/dcb_cohesive.toml) opened under displacement control to δ = 10 mm on
-several meshes (issue 13): speed (steps, Newton iterations, CPU and wall time) and the mesh
+several meshes: speed (steps, Newton iterations, CPU and wall time) and the mesh
 convergence of the answer against corrected beam theory (Williams 1989). Uses the setup of
 tests/test_dcb.py (``displacement_controlled``).
 

@@ -45,7 +45,7 @@ Measured again 24 Nov 2026 on another CPU (AMD EPYC, 2 cores, load average 0.8-0
 elements, 1 thread; the all-CPU roofline 105 GFLOP/s, one CPU 53): the MITC9 kernel over the
 full one per element 1.24 (d = 1), 1.13 (d = 2), 1.15-1.19 (d = 3; at equal points 0.85-0.90),
 1.11 (d = 4; 0.96); MITC9 s 0.093 / 0.172 / 0.231-0.245 / 0.495; roofline share 0.24 / 0.28 /
-0.45 / 0.43 (of one CPU 0.89 at d = 3). The ratio is within the issue's 1.3 for every d on this
+0.45 / 0.43 (of one CPU 0.89 at d = 3). The ratio is within 1.3 for every d on this
 CPU; the 1.31-1.32 at d = 3 above was measured on the earlier one.
 """
 from __future__ import annotations

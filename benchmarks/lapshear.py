@@ -1,4 +1,4 @@
-"""Single-lap shear test with the cohesive law (issue 13, examples/lapshear_cohesive.toml): the
+"""Single-lap shear test with the cohesive law (examples/lapshear_cohesive.toml): the
 peak load against the bond length and the path against the closed form (Yuan et al. 2004), as
 the table in docs/user-guide.md. Uses the path tracer of tests/test_lapshear.py.
 

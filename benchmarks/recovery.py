@@ -10,7 +10,7 @@ Gauss levels of every layer, the two patch-recovery products and the evaluation 
 the solid ParaView file writes (all elements × layers × 27 lattice points); the patch operators
 themselves (``Recovery(...)``) are built once per model and reported separately.
 Last line, for the largest mesh: ``recovery/newton=<ratio>`` (the recovery of one state,
-issue 14's "recovery costs less than one Newton iteration": must stay below 1) and
+the target "recovery costs less than one Newton iteration": below 1) and
 ``with_solid_vtu/newton=<ratio>`` (plus the evaluation at every lattice point of the solid
 ParaView file, an output step's whole stress export).
 """

@@ -1,4 +1,4 @@
-"""Cost of recording a load step against the length of the history (issue 15).
+"""Cost of recording a load step against the length of the history.
 
     PYTHONPATH=src python benchmarks/results_writing.py [--steps 1500] [--out DIR]
 
@@ -6,7 +6,7 @@ Runs the thick cantilever (examples/cantilever_thick.toml, 5 elements, linear, s
 few milliseconds of solving) with ``--steps`` load steps into a results folder (no ParaView files,
 no figures) and times every step from the progress callback (solve + probes + everything written
 for the step). Reported: the mean time per step in the first and the last 100 steps, the total,
-and the part of it that is not solving (total minus the steps' own solve times). Before issue 15
+and the part of it that is not solving (total minus the steps' own solve times). Without the recorder
 every step rewrote summary.json, probes.csv and the checkpoint with the whole history, so the
 time per step grew linearly with the step number (quadratic total); with the recorder the
 per-step files are appended and the checkpoint holds the state only, so it stays flat.
@@ -18,7 +18,7 @@ Run it once with the sources of each version on PYTHONPATH to compare. Last line
 version                total s   not solving s   ms/step first 100   ms/step last 100
 =====================  ========  ==============  ==================  =================
 before (db602f8)       83.7      71.3            35.7                78.1
-recorder (issue 15)    19.3      10.7            18.0                12.2
+recorder               19.3      10.7            18.0                12.2
 =====================  ========  ==============  ==================  =================
 
 (an earlier, more loaded pair: 122.5 s with 44 → 152 ms/step before, 40.0 s with 35 → 33 ms/step

@@ -1,4 +1,4 @@
-"""Scaling of one Newton iteration with the mesh: two-layer plate under pressure (issue 6).
+"""Scaling of one Newton iteration with the mesh: two-layer plate under pressure.
 
     python benchmarks/scaling.py [--directors 2] [--sizes 12 17 24 34 48] [--max-dofs 300000]
 

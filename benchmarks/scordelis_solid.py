@@ -1,6 +1,6 @@
 """Scordelis-Lo roof as a 3D linear-elastic solid (scikit-fem quadratic hexahedra): the converged
-deflection of the 3D problem, against which layershell's converged value is checked (issue 14;
-docs/vs_solid.md §3).
+deflection of the 3D problem, against which layershell's converged value is checked
+(docs/vs_solid.md §3).
 
     pip install -e ".[bench]"            # scikit-fem, only for this benchmark
     python benchmarks/scordelis_solid.py [--n 8 16 32 64] [--m 1 2 4] [--loads body outer middle]

@@ -1,4 +1,4 @@
-"""Sparse direct solvers on the reduced tangents of this project's models (issue 6).
+"""Sparse direct solvers on the reduced tangents of this project's models.
 
     python benchmarks/solvers.py [--plate 16] [--mmd-max-dofs 40000] [--repeat 3]
 

@@ -1,4 +1,4 @@
-"""Wall time of the thesis examples under examples/ (issue 6; target: each under 60 s).
+"""Wall time of the thesis examples under examples/ (target: each under 60 s).
 
     python benchmarks/thesis_examples.py [NAME ...] [--skip NAME ...] [--timeout 900] [--vtu]
 
