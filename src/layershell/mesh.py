@@ -386,9 +386,11 @@ def _inner_grid(mesh: Mesh, elements: np.ndarray, n: int) -> np.ndarray:
 def elements_cut_by(mesh: Mesh, inside, n: int = 7) -> np.ndarray:
     """Ids of the elements that a region's boundary crosses instead of following their edges:
     ``inside(points (m, 3)) -> (m,) bool`` takes both values on an n × n grid just inside them."""
-    pts = _inner_grid(mesh, np.arange(mesh.n_elements), n).reshape(-1, 3)
-    flags = np.asarray(inside(pts), bool).reshape(mesh.n_elements, n * n)
-    return np.flatnonzero(flags.any(1) & ~flags.all(1))
+    cut = []
+    for block in np.array_split(np.arange(mesh.n_elements), max(1, mesh.n_elements // 20_000)):  # bounded memory
+        flags = np.asarray(inside(_inner_grid(mesh, block, n).reshape(-1, 3)), bool).reshape(block.size, n * n)
+        cut.append(block[flags.any(1) & ~flags.all(1)])
+    return np.concatenate(cut)
 
 
 def axis_crossings(mesh: Mesh, inside, elements: np.ndarray, n: int = 7) -> tuple[np.ndarray, np.ndarray]:
