@@ -373,7 +373,7 @@ def rectangle(lx: float, ly: float, nx: int, ny: int, origin=(0.0, 0.0, 0.0), no
 
 def _inner_grid(mesh: Mesh, elements: np.ndarray, n: int) -> np.ndarray:
     """(e, n, n, 3) points of ``elements`` on an n × n grid just inside each element
-    (ξ, η ∈ ±(1 − 10⁻⁶)), rows along η, columns along ξ."""
+    (ξ, η ∈ ±(1 − 10⁻⁶)), indexed [element, η, ξ]."""
     from .element.shape import quad9
 
     t = np.linspace(-1.0 + 1e-6, 1.0 - 1e-6, n)
@@ -396,8 +396,8 @@ def elements_cut_by(mesh: Mesh, inside, n: int = 7) -> np.ndarray:
 def axis_crossings(mesh: Mesh, inside, elements: np.ndarray, n: int = 7) -> tuple[np.ndarray, np.ndarray]:
     """Where a region's boundary crosses ``elements`` of a flat mesh with axis-parallel edges:
     the distinct x at which ``inside`` changes along lines of constant y through them, and the
-    distinct y along lines of constant x (n lines each, located by bisection to 10⁻¹² of the
-    element size), rounded to 10⁻⁹ of the mesh size in decimal digits."""
+    distinct y along lines of constant x (n lines each, located by bisection to better than 10⁻¹²
+    of the element size), rounded to 10⁻⁹ of the mesh size in decimal digits."""
     grid = _inner_grid(mesh, np.asarray(elements, np.int64), n)
     rows, cols = grid, grid.transpose(0, 2, 1, 3)  # lines along ξ, then along η
     a = np.concatenate([rows[:, :, :-1].reshape(-1, 3), cols[:, :, :-1].reshape(-1, 3)])

@@ -272,8 +272,8 @@ class LayerDef(Strict):
 class StackDef(Strict):
     layers: list[str] = Field(min_length=1, description="layer names from the reference face outward")
     where: str | None = Field(None, description=(
-        "the elements whose centre satisfies this condition; a stack without where and set takes the elements "
-        "of no other stack"))
+        "the elements whose centre satisfies this condition (on a rectangle mesh its boundary must lie on element "
+        "edges: node lines by lines_x/lines_y); a stack without where and set takes the elements of no other stack"))
     set: str | None = Field(None, description=_SET_E)
 
 
