@@ -266,26 +266,41 @@ def test_mode_i_slender_limit_scaling():
 
 
 def test_modulus_along_the_crack_direction():
-    """The arms' modulus is the in-plane modulus along the finer mesh direction (where the front
-    runs): E1 along the fibres, E2 across them (the DCB with `direction = [0, 1, 0]` has a mode-I
-    zone (11/150)^(1/4) as long: c_I = Σ 12/(E h³) changes, the foundation does not), the
-    transverse shear modulus
-    G31 → G23; an isotropic layer has E in every direction."""
+    """The arms' moduli are those along the finer mesh direction (where the front runs): E1, G31
+    and ν13 along the fibres, E2, G23 and ν23 across them; an isotropic layer has E in every
+    direction. The DCB with `direction = [0, 1, 0]` has arms of E = 11 GPa along the crack: its
+    thick-body estimate M E'_I G_Ic/σ0² follows their crack-tip modulus (Sih, Paris & Irwin), with
+    the node spacing and the direction unchanged."""
     from layershell.material import Orthotropic
-    from layershell.process_zone import in_plane_modulus
+    from layershell.process_zone import THICK_FACTOR, Arm, crack_tip_moduli, in_plane_modulus
 
     m = Orthotropic(150000.0, 11000.0, 11000.0, 6000.0, 3700.0, 6000.0, 0.25, 0.45, 0.0183)
-    assert in_plane_modulus(m, 0.0) == pytest.approx((150000.0, 6000.0))
-    assert in_plane_modulus(m, np.pi / 2) == pytest.approx((11000.0, 3700.0))
+    assert in_plane_modulus(m, 0.0) == pytest.approx((150000.0, 6000.0, 0.0183 * 150 / 11))
+    assert in_plane_modulus(m, np.pi / 2) == pytest.approx((11000.0, 3700.0, 0.45))
     iso = Orthotropic.isotropic(30000.0, 0.2)
     assert in_plane_modulus(iso, 0.7)[0] == pytest.approx(30000.0)
     from helpers import EXAMPLES
 
     text = (EXAMPLES / "dcb_cohesive.toml").read_text()
-    ests = []
-    for t in (text, text.replace("direction = [1, 0, 0]", "direction = [0, 1, 0]")):
+    for t, arm in ((text, Arm(1.98, 150000.0, 11000.0, 6000.0, 0.0183 * 150 / 11)),
+                   (text.replace("direction = [1, 0, 0]", "direction = [0, 1, 0]"), Arm(1.98, 11000.0, 11000.0,
+                                                                                          3700.0, 0.45))):
         spec = build(parse(t, "dcb"), EXAMPLES)
         est, h, e = process_zone_estimate(spec.model, Problem.build(spec.model).interfaces.runs[0])
         assert e == pytest.approx([1.0, 0.0, 0.0]) and h == pytest.approx(0.5)
-        ests.append(est["I"]["slender"])
-    assert ests[1] / ests[0] == pytest.approx((11 / 150) ** 0.25, rel=1e-9)
+        assert est["I"]["thick"] == pytest.approx(THICK_FACTOR * crack_tip_moduli(arm)[0] * 0.352 / 30.0**2)
+
+
+def test_crack_tip_modulus():
+    """E' (G = K²/E') of an isotropic layer is E in both modes (plane stress); of the DCB's
+    carbon/epoxy along the fibres (E1 = 150, E3 = 11, G13 = 6 GPa, ν13 = 0.25) E'_I = 14.4 GPa,
+    between E3 and E1, and E'_II = 53 GPa (the Sih, Paris & Irwin relation evaluated by hand:
+    a11 = 1/150000, a22 = 1/11000, a12 = -0.25/150000, a66 = 1/6000 per MPa; ρ = 3.993); a rigid
+    layer's is infinite, so a strip on a rigid substrate has twice its own."""
+    from layershell.process_zone import Arm, crack_tip_moduli
+
+    iso = Arm(1.0, 30000.0, 30000.0, 30000.0 / 2.4, 0.2)
+    assert crack_tip_moduli(iso) == pytest.approx((30000.0, 30000.0), rel=1e-12)
+    EI, EII = crack_tip_moduli(Arm(1.98, 150000.0, 11000.0, 6000.0, 0.25))
+    assert EI == pytest.approx(14390.0, rel=2e-3) and EII == pytest.approx(53130.0, rel=2e-3)
+    assert crack_tip_moduli(Arm(1.0, np.inf, np.inf, np.inf)) == (np.inf, np.inf)

@@ -190,6 +190,10 @@ def check(model: Path = typer.Argument(..., help="model file (TOML)")):
         _fail(f"{model}: the supports, layer bonds, loads and interfaces could not be set up ({type(exc).__name__}: "
               f"{exc}); check 'supports', 'loads' and 'interfaces' (set LAYERSHELL_TRACEBACK=1 to see where it failed)")
     m = spec.model
+    from .checks import pre_run_warnings
+
+    for text in pre_run_warnings(spec):  # supports that do not hold a layer, a mesh coarser than the process zone
+        err.print(f"warning: {escape(f'{model}: {text}')}", highlight=False, soft_wrap=True)
     pf = spec.path_following
     if pf is None:
         steps = f"{len(spec.load_factors)} load step(s)"

@@ -736,8 +736,8 @@ def _arm(model, k: int, direction: np.ndarray, normal: np.ndarray) -> Arm:
     a1 = np.asarray(ly.direction, float) if ly.direction is not None else np.array([1.0, 0.0, 0.0])
     a1 = a1 - (a1 @ normal) * normal  # its tangent-plane projection; the material axis 1 is at ω from it
     theta = float(np.arctan2(np.cross(a1, direction) @ normal, a1 @ direction))
-    E, G = in_plane_modulus(mat, theta - ly.angle)
-    return Arm(float(ly.thickness.min()), E, mat.E3, G)
+    E, G, nu = in_plane_modulus(mat, theta - ly.angle)
+    return Arm(float(ly.thickness.min()), E, mat.E3, G, nu)
 
 
 def _held(model, k: int) -> bool:
@@ -755,10 +755,15 @@ def _held(model, k: int) -> bool:
 def process_zone_estimate(model, r: CohesiveRun) -> tuple[dict, float, np.ndarray]:
     """The process-zone lengths of a cohesive interface per mode (:mod:`layershell.process_zone`,
     with its penalty K and the two adjacent layers as arms along the finer mesh direction), the
-    node spacing h along that direction (half the shorter side of the largest elements: the
-    front runs along one side) and that direction."""
-    cb = r.block.contact
-    X = model.mesh.nodes[cb.conn]  # (e, 9, 3)
+    node spacing h along that direction and that direction (:func:`interface_zone_estimate`)."""
+    return interface_zone_estimate(model, r.block.contact.itf, r.law, r.block.K)
+
+
+def interface_zone_estimate(model, itf: Interface, law: CohesiveLaw, K: float) -> tuple[dict, float, np.ndarray]:
+    """:func:`process_zone_estimate` from the model alone (before a run): the interface ``itf``
+    with its cohesive ``law`` and penalty ``K``. The node spacing h is half the shorter side of
+    the largest elements (the front runs along one side)."""
+    X = model.mesh.nodes[model.mesh.elements[itf.elements]]  # (e, 9, 3)
     s1, s3 = X[:, 1] - X[:, 0], X[:, 3] - X[:, 0]
     n1, n3 = np.linalg.norm(s1, axis=-1), np.linalg.norm(s3, axis=-1)
     i1, i3 = int(np.argmax(n1)), int(np.argmax(n3))
@@ -768,9 +773,14 @@ def process_zone_estimate(model, r: CohesiveRun) -> tuple[dict, float, np.ndarra
         h, e, i = 0.5 * n3[i3], s3[i3] / n3[i3], i3
     nrm = np.cross(s1[i], s3[i])
     nrm = nrm / np.linalg.norm(nrm)
-    law = r.law
-    arms = (_arm(model, cb.itf.lower, e, nrm), _arm(model, cb.itf.upper, e, nrm))
-    return zone_lengths(law.G_Ic, law.G_IIc, law.sigma_max, law.tau_max, r.block.K, arms), float(h), e
+    arms = (_arm(model, itf.lower, e, nrm), _arm(model, itf.upper, e, nrm))
+    return zone_lengths(law.G_Ic, law.G_IIc, law.sigma_max, law.tau_max, K, arms), float(h), e
+
+
+def zone_description(est: dict) -> str:
+    """'mode I 0.35 (thick-body estimate), mode II 8.5 (slender-layer estimate)'."""
+    kind = {"thick": "thick-body estimate M E' G_c/σ²", "slender": "slender-layer (beam) estimate"}
+    return ", ".join(f"mode {m} {est[m]['length']:.4g} ({kind[est[m]['used']]})" for m in ("I", "II"))
 
 
 def _process_zone_warning(model, r: CohesiveRun, B: float) -> list[str]:
@@ -786,8 +796,8 @@ def _process_zone_warning(model, r: CohesiveRun, B: float) -> list[str]:
         return []
     name = r.block.contact.itf.name
     return [f"interface '{name}': damage started (mode ratio G_II/G = {B:.2f}); its process zone, from the "
-            f"onset of damage to complete separation, is estimated at {lcz:.4g} (mode I {lI:.4g}, mode II "
-            f"{lII:.4g}; layershell.process_zone) and spans {lcz / h:.2f} node spacings (h = {h:.4g}), fewer "
+            f"onset of damage to complete separation, is estimated at {lcz:.4g} ({zone_description(est)}; "
+            f"layershell.process_zone) and spans {lcz / h:.2f} node spacings (h = {h:.4g}), fewer "
             "than 3: the peak load and the debonding load are then mesh dependent (Turon et al. 2007). Refine "
             f"the mesh along the debonding front to a node spacing of at most {lcz / 3:.3g} (elements of "
             f"{2 * lcz / 3:.3g}), or check that G_Ic, G_IIc and the strengths are consistent"]
