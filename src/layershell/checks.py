@@ -146,5 +146,15 @@ def process_zone_warnings(spec) -> list[str]:
 
 
 def pre_run_warnings(spec) -> list[str]:
-    """All warnings of this module (`layershell check`)."""
-    return [*unheld_layer_warnings(spec), *process_zone_warnings(spec)]
+    """All warnings of this module (`layershell check`). They advise and never stop a check: a
+    model they cannot assess (an error of their own) gets no warning from them."""
+    import os
+
+    out = []
+    for check in (unheld_layer_warnings, process_zone_warnings):
+        try:
+            out += check(spec)
+        except Exception:
+            if os.environ.get("LAYERSHELL_TRACEBACK"):
+                raise
+    return out
