@@ -69,10 +69,12 @@ def write_profiles(spec, problem, u, rec: Recorder, load_factor: float = 1.0) ->
         rec.write_csv(f"profile_{pr.name}.csv", ["theta3"] + names, rows)
         files[pr.name] = f"profile_{pr.name}.csv"
         if spec.output.plots:
-            from .plots import plot_through_thickness
+            from .plots import height_axis, plot_through_thickness
+            from .units import Units, axis_label
 
-            plot_through_thickness(rec.path(f"profile_{pr.name}.png"),
-                                   {k: (v, t) for k, (t, v) in cols.items()}, f"{pr.measure} σ{pr.component}")
+            plot_through_thickness(rec.path(f"profile_{pr.name}.png"), {k: (v, t) for k, (t, v) in cols.items()},
+                                   axis_label(f"{pr.measure} σ{pr.component}", Units.parse(spec.model.units).stress),
+                                   height=height_axis(spec.model, pr.point))
     return files
 
 
@@ -833,6 +835,10 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
             raise pending
         if rcd is not None and spec.profiles and summary["steps"]:
             summary["profiles"] = write_profiles(spec, problem, u, rcd, float(summary["steps"][-1]["load_factor"]))
+        if rcd is not None and spec.lines and summary["steps"]:
+            from .io.lines import write_lines
+
+            summary["lines"] = write_lines(spec, problem, u, rcd, float(summary["steps"][-1]["load_factor"]))
         if rcd is not None:
             rcd.summary(summary, force=True)
             if spec.output.plots:
