@@ -2,6 +2,8 @@
 and that the plotted data are the run's results (against independent references where possible)."""
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from helpers import EXAMPLES
@@ -200,3 +202,237 @@ def test_zone_steps_are_validated():
         _spec(SUCTION, {"vtu = false": "vtu = false\nzone_steps = [0]"})
     with pytest.raises(InputError, match="zone_steps"):
         _spec(SUCTION, {"vtu = false": "vtu = false\nzone_steps = [2, 2]"})
+
+
+# ----------------------------------------------------------------------------- what the axes say
+
+
+class _Figures:
+    """The figures that plots writes, as seen just before they are saved (artists, not pixels)."""
+
+    def __init__(self, monkeypatch):
+        from layershell import plots
+
+        self.saved: dict[str, object] = {}
+        save = plots._save
+
+        def keep(fig, path):
+            savefig = fig.savefig
+
+            def snapshot_and_save(*args, **kwargs):  # after the layout of the tick labels
+                fig.canvas.draw()
+                self.saved[Path(path).name] = self._snapshot(fig)
+                return savefig(*args, **kwargs)
+
+            fig.savefig = snapshot_and_save
+            return save(fig, path)
+
+        monkeypatch.setattr(plots, "_save", keep)
+
+    @staticmethod
+    def _snapshot(fig) -> list[dict]:
+        renderer = fig.canvas.get_renderer()
+        axes = []
+        for ax in fig.axes:
+            if not ax.get_visible() or ax.name != "rectilinear" or not ax.get_xlabel():
+                continue  # colour bars have no x label
+            ticks = {}
+            for axis in (ax.xaxis, ax.yaxis):
+                lo, hi = sorted(axis.get_view_interval())
+                boxes = [t.label1.get_window_extent(renderer) for t in axis.get_major_ticks()
+                         if lo - 1e-9 * (hi - lo) <= t.get_loc() <= hi + 1e-9 * (hi - lo) and t.label1.get_text()]
+                ticks[axis.axis_name] = boxes
+            axes.append({
+                "title": ax.get_title(), "xlabel": ax.get_xlabel(), "ylabel": ax.get_ylabel(), "ticks": ticks,
+                "lines": {ln.get_label(): np.asarray(ln.get_xydata(), float) for ln in ax.get_lines()},
+                "polys": [[np.asarray(p.vertices, float) for p in c.get_paths()] for c in ax.collections
+                          if type(c).__name__ == "PolyCollection"],
+            })
+        return axes
+
+
+def _overlapping(boxes, axis_name: str) -> bool:
+    if axis_name == "x":
+        spans = sorted((b.x0, b.x1) for b in boxes)
+    else:
+        spans = sorted((b.y0, b.y1) for b in boxes)
+    return any(a[1] > b[0] for a, b in zip(spans[:-1], spans[1:]))
+
+
+def test_tick_labels_do_not_overlap(monkeypatch, tmp_path):
+    """Long negative tick labels (−0.0123 …, −98765 …) in three panels side by side: no two tick
+    labels of an axis overlap."""
+    from layershell.plots import plot_load_displacement
+
+    figs = _Figures(monkeypatch)
+    lam = np.linspace(0.0, 1.0, 11)
+    plot_load_displacement(tmp_path / "ld.png", lam, {"a": -0.0123456 * lam, "b": -98765.4321 * lam,
+                                                        "c": 1e-7 * lam - 3e-6}, units="mm")
+    axes = figs.saved["ld.png"]
+    assert len(axes) == 3
+    for ax in axes:
+        for name, boxes in ax["ticks"].items():
+            assert len(boxes) >= 2, (ax["title"], name)
+            assert not _overlapping(boxes, name), (ax["title"], name)
+
+
+def test_units_derived_from_the_unit_system():
+    from layershell.units import Units
+
+    u = Units.parse("N, mm")
+    assert (u.force, u.length, u.stress, u.per_length, u.area) == ("N", "mm", "N/mm²", "N/mm", "mm²")
+    assert Units.parse("m, kN") == Units.parse("kN, m") == Units("kN", "m")
+    assert Units.parse("kN, m").of_probe("stress", "11") == "kN/m²"
+    assert Units.parse("kN, m").of_probe("traction", "33") == "kN/m²"
+    assert Units.parse("kN, m").of_probe("debonded_area") == "m²"
+    assert Units.parse("kN, m").of_probe("reaction", "z") == "kN"
+    assert Units.parse("kN, m").of_probe("reaction", "mx") == "kN·m"
+    assert Units.parse("kN, m").of_probe("resultant", "n") == "kN/m"
+    assert Units.parse("kN, m").of_probe("resultant", "m") == "kN·m/m"
+    assert Units.parse("kN, m").of_probe("displacement", "z") == "m"
+    assert Units.parse("kN, m").of_probe("load_factor") == ""
+    assert Units.parse("").stress == "" and Units.parse("SI").of_probe("stress") == ""
+
+
+def test_stress_and_zone_axes_in_physical_units(monkeypatch, tmp_path):
+    """The suction block (units kN, m): stress and traction axes in kN/m², not the unit system;
+    the debonded-zone map in m with the area in m² (the whole 2 × 1 m interface: 2 m²)."""
+    figs = _Figures(monkeypatch)
+    res = run(_spec(SUCTION), tmp_path)
+    assert res.converged
+    t33 = figs.saved["load_displacement_t33.png"][0]
+    assert t33["xlabel"] == "t33 [kN/m²]" and t33["ylabel"] == "load factor λ"
+    thick = figs.saved["thickness_s33_base.png"][0]
+    assert thick["xlabel"].endswith("[kN/m²]"), thick["xlabel"]
+    zone = figs.saved["debonded_zone_base_top.png"][0]
+    assert (zone["xlabel"], zone["ylabel"]) == ("x [m]", "y [m]")
+    assert zone["title"].endswith("debonded area 2 m²"), zone["title"]
+    assert figs.saved["load_debonded_area.png"][0]["xlabel"] == "debonded area [m²]"
+    assert not any("kN, m" in ax["xlabel"] + ax["ylabel"] for axes in figs.saved.values() for ax in axes)
+
+
+#: a 100 × 10 mm strip (one layer 1 mm thick), clamped at x = 0 and pulled at x = 100 by a
+#: prescribed displacement λ × 0.5 mm
+STRIP = """
+[model]
+units = "N, mm"
+nonlinear = false
+[mesh]
+type = "rectangle"
+lx = 100.0
+ly = 10.0
+nx = 2
+ny = 1
+[materials.m]
+type = "isotropic"
+E = 1000.0
+nu = 0.0
+[[layers]]
+name = "strip"
+material = "m"
+thickness = 1.0
+directors = 1
+[[supports]]
+type = "fix"
+where = "near(x, 0)"
+components = ["x", "y", "z"]
+[[supports]]
+type = "fix"
+where = "near(x, 100)"
+components = ["x"]
+value = [0.5]
+[steps]
+factors = [0.5, 1.0]
+[[probes]]
+name = "u_end"
+quantity = "displacement"
+point = [100, 5, 0]
+component = "x"
+[[probes]]
+name = "N"
+quantity = "reaction"
+where = "near(x, 100)"
+component = "x"
+[output]
+vtu = false
+"""
+
+
+def test_load_axis_under_displacement_control(monkeypatch, tmp_path):
+    """Pulled by a prescribed displacement, the y axis is that displacement (λ × 0.5 mm), not
+    'load factor': the end's own displacement (x) equals it (y) at every step; the reaction axis
+    is in N."""
+    figs = _Figures(monkeypatch)
+    res = run(_spec(STRIP), tmp_path)
+    assert res.converged
+    ax = figs.saved["load_displacement_u_end.png"][0]
+    assert ax["ylabel"] == "prescribed displacement λ × 0.5 [mm]"
+    assert ax["xlabel"] == "u_end [mm]"
+    (xy,) = [v for v in ax["lines"].values() if len(v) == 2]
+    assert xy[:, 1] == pytest.approx([0.25, 0.5], rel=1e-12)
+    assert xy[:, 0] == pytest.approx(xy[:, 1], rel=1e-9)
+    n = figs.saved["load_displacement_N.png"][0]
+    assert n["xlabel"] == "N [N]"
+
+
+def test_load_axis_names_what_the_load_factor_scales():
+    from layershell.plots import load_axis
+
+    pulled_two_ways = STRIP + '[[supports]]\ntype = "fix"\nwhere = "near(x, 50)"\ncomponents = ["y"]\nvalue = [-0.25]\n'
+    assert load_axis(_spec(pulled_two_ways).model) == ("largest prescribed displacement λ × 0.5 [mm]", 0.5)
+    loaded = STRIP + '[[loads]]\ntype = "surface"\nface = "top"\ndirection = [0, 0, 1]\nmagnitude = 1.0\n'
+    assert load_axis(_spec(loaded).model)[0] == "load factor λ (scales the loads and prescribed displacements)"
+    assert load_axis(_spec(SUCTION).model) == ("load factor λ", 1.0)
+
+
+def test_deformed_shape_shows_a_lifted_layer(monkeypatch, tmp_path):
+    """Two layers, the upper one lifted off by δ everywhere (a hand-made displacement: its
+    director 0 moved by δ along z, the lower layer at rest): the reference face does not move,
+    but the section of deformed.png shows the gap δ × the stated magnification between the lower
+    layer's top face (z = 0.2) and the upper layer's bottom face."""
+    from layershell.dofs import number_dofs
+    from layershell.plots import plot_deformed
+
+    spec = _spec(SUCTION)
+    model = spec.model
+    dm = number_dofs(model)
+    delta = 0.01
+    u = np.zeros(int(dm.layer_dofs[1].max()) + 1)
+    top = model.layers.index(next(ly for ly in model.layers if ly.name == "top"))
+    u[dm.layer_dofs[top][:, 0, 2]] = delta
+    figs = _Figures(monkeypatch)
+    _, info = plot_deformed(tmp_path / "deformed.png", model, dm, u, info=True)
+    assert info["separation"] == pytest.approx(delta, rel=1e-12)
+    assert info["max_u"] == 0.0  # the reference face (the lower layer's bottom) is at rest
+    (section,) = figs.saved["deformed.png"]
+    scale = info["scale"]
+    assert f"× {scale:.3g}" in section["title"] and section["ylabel"] == "z [m]"
+    lower, upper = (np.concatenate(p) for p in section["polys"])
+    assert lower[:, 1].max() == pytest.approx(0.2, abs=1e-12)
+    assert upper[:, 1].min() - lower[:, 1].max() == pytest.approx(scale * delta, rel=1e-9)
+    assert upper[:, 1].max() == pytest.approx(0.25 + scale * delta, rel=1e-9)
+
+
+def test_profiles_against_the_physical_height(monkeypatch, tmp_path):
+    """Lamé ring (reference face outside, normal A3 = −e_r): at the probes' point (0, 5) the
+    height axis is y = 5 − Θ³, the radius, and every plotted point lies on Lamé's σ_φ(r) and
+    σ_r(r) (p = 1, a = 2.5, b = 5) within 2 %. A plate with normal −z: height z = −Θ³."""
+    figs = _Figures(monkeypatch)
+    spec = _spec((EXAMPLES / "ring.toml").read_text())
+    res = run(spec, None)
+    write_figures(tmp_path, spec, res.problem, res.u, res.summary, through_thickness=through_thickness)
+    a, b = 2.5, 5.0
+    lame = {"11": lambda r: -b**2 / (b**2 - a**2) * (1 + a**2 / r**2),
+            "33": lambda r: -b**2 / (b**2 - a**2) * (1 - a**2 / r**2)}
+    for probe, comp in (("sigma_phi_inner", "11"), ("sigma_r_outer", "33")):
+        (ax,) = figs.saved[f"thickness_{probe}.png"]
+        assert ax["ylabel"] == "height y [m]" and ax["xlabel"].endswith("[kN/m²]")
+        sr = ax["lines"]["ring"]
+        assert sr[:, 1].min() == pytest.approx(a) and sr[:, 1].max() == pytest.approx(b)
+        assert np.abs(sr[:, 0] - lame[comp](sr[:, 1])).max() < 0.02 * abs(lame["11"](a))
+        probe_mark = ax["lines"]["probe"][0]
+        assert probe_mark[0] == pytest.approx(lame[comp](probe_mark[1]), abs=0.02 * abs(lame["11"](a)))
+    from layershell.plots import height_axis
+
+    flipped = _spec(SUCTION.replace('ny = 1\n', 'ny = 1\nnormal = "-z"\n', 1)).model
+    assert height_axis(flipped, [1.0, 0.5, 0.0]) == (0.0, -1.0, "height z [m]")
