@@ -153,7 +153,8 @@ def pre_run_warnings(spec) -> list[str]:
     out = []
     for check in (unheld_layer_warnings, process_zone_warnings):
         try:
-            out += check(spec)
+            with np.errstate(all="ignore"):
+                out += check(spec)
         except Exception:
             if os.environ.get("LAYERSHELL_TRACEBACK"):
                 raise
