@@ -2,8 +2,9 @@
 likely to do what the model means.
 
 * :func:`unheld_layer_warnings`: a support on one layer holds the layers that are bonded to it;
-  a layer that is connected to it only through a cohesive or delaminating interface keeps its own
-  displacements there and is held only by the interface's tractions.
+  a layer that is connected to it only through a cohesive interface keeps its own displacements
+  there and is held only by the interface's tractions (through a stress-criterion interface, only
+  until it debonds).
 * :func:`process_zone_warnings`: the cohesive process zone (:mod:`layershell.process_zone`)
   against the node spacing of the mesh (at least 3 node spacings, Turon et al. 2007).
 """
