@@ -64,7 +64,9 @@ class Strict(BaseModel):
 # ------------------------------------------------------------------ general settings
 class ModelSettings(Strict):
     title: str = Field("", description="title shown in the report and the figures")
-    units: str = Field("", description="force and length unit, 'force, length' (e.g. 'kN, m'): names the units of the report and the figure axes (stresses force/length², resultants force/length, areas length²); nothing is converted")
+    units: str = Field("", description=(
+        "force and length unit, 'force, length' (e.g. 'kN, m'): names the units of the report and the figure axes "
+        "(stresses force/length², resultants force/length, areas length²); nothing is converted"))
     nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
     thickness_points: PositiveInt = Field(
         3, le=10, description="Gauss points through each layer (at least d are used: d = 4 needs 4)")
