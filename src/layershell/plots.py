@@ -278,11 +278,10 @@ def section_points(model: Model, axis: int, value: float, n: int = 9):
     q_f = np.stack([f[:, a, b] for a, b in corners], -1).reshape(-1, 4)
     q_p = np.stack([np.stack([XI[a, b], ETA[a, b]], -1) for a, b in corners], -2)  # (n-1, n-1, 4, 2)
     q_p = np.broadcast_to(q_p, (ne,) + q_p.shape).reshape(-1, 4, 2)
-    q_e = np.repeat(np.arange(ne), (n - 1) ** 2)
-    tri = np.array([[0, 1, 2], [0, 2, 3]])
+    tri = np.array([[0, 1, 2], [0, 2, 3]])  # two triangles per cell
     tf = q_f[:, tri].reshape(-1, 3)  # (T, 3)
-    tp = np.stack([q_p[:, tri[0]], q_p[:, tri[1]]], 1).reshape(-1, 3, 2)
-    te = np.repeat(q_e, 2)
+    tp = q_p[:, tri].reshape(-1, 3, 2)
+    te = np.repeat(np.arange(ne), 2 * (n - 1) ** 2)
     cut = (tf.min(1) < 0.0) & (tf.max(1) > 0.0)
     tf, tp, te = tf[cut], tp[cut], te[cut]
     ends = []
@@ -358,7 +357,7 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
         node = int(np.argmax(norms)) if len(u) else 0
     plane = section_plane(model, mesh.nodes[node])
     if scale is None:
-        scale = _default_scale(model, u, umax, plane[3])
+        scale = _default_scale(model, u, max(umax, separation), plane[3], separation)
     comp = {"x": 0, "y": 1, "z": 2, "ux": 0, "uy": 1, "uz": 2}
     if field == "magnitude":
         val, label = norms, "|u|"
@@ -378,9 +377,9 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     _draw_section(ax, model, dm, u_full, plane, scale)
     axis, value, horizontal, vertical = plane
     where = "the largest layer separation" if separation > 1e-9 * umax else "the largest displacement"
-    ax.set_title(f"section {'xyz'[axis]} = {value:.4g}{' ' + length if length else ''} through {where}; displacements × {scale:.3g}\n"
-                 f"largest separation of two layers: {separation:.3g}{' ' + length if length else ''}",
-                 fontsize=10)
+    unit = f" {length}" if length else ""
+    ax.set_title(f"section {'xyz'[axis]} = {value:.4g}{unit} through {where}; displacements × {scale:.3g}\n"
+                 f"largest separation of two layers: {separation:.3g}{unit}", fontsize=10)
     ax.set_xlabel(axis_label("xyz"[horizontal], length))
     ax.set_ylabel(axis_label("xyz"[vertical], length))
     ax.grid(True, alpha=0.3)
@@ -392,13 +391,14 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     return path
 
 
-def _default_scale(model: Model, u: np.ndarray, umax: float, vertical: int) -> float:
-    """Magnification: the largest displacement as 10 % of the model size, or the largest one along
-    the section's vertical axis as twice the thickness where that is less, not below 1."""
+def _default_scale(model: Model, u: np.ndarray, umax: float, vertical: int, separation: float = 0.0) -> float:
+    """Magnification: the largest displacement ``umax`` as 10 % of the model size, or the largest
+    one along the section's vertical axis (or the largest separation of two layers) as twice the
+    thickness where that is less, not below 1."""
     if umax <= 0.0:
         return 1.0
     scale = 0.1 * model.mesh.size() / umax
-    across = float(np.abs(u[:, vertical]).max())
+    across = max(float(np.abs(u[:, vertical]).max()), separation)
     thickness = float(model.total_thickness().max())
     if across > 0.0 and thickness > 0.0:
         scale = min(scale, max(1.0, 2.0 * thickness / across))
