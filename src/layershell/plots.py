@@ -353,8 +353,8 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     norms = np.linalg.norm(u, axis=1)
     umax = float(norms.max()) if len(u) else 0.0
     separation, node = layer_separation(model, dm, u_full)
-    if node < 0 or separation <= 1e-9 * umax:
-        node = int(np.argmax(norms)) if len(u) else 0
+    if node < 0 or separation <= 1e-9 * umax:  # bonded layers: round-off
+        separation, node = 0.0, int(np.argmax(norms)) if len(u) else 0
     plane = section_plane(model, mesh.nodes[node])
     if scale is None:
         scale = _default_scale(model, u, max(umax, separation), plane[3], separation)
@@ -376,9 +376,9 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     ax = fig.add_subplot(grid[1])
     _draw_section(ax, model, dm, u_full, plane, scale)
     axis, value, horizontal, vertical = plane
-    where = "the largest layer separation" if separation > 1e-9 * umax else "the largest displacement"
+    where = "the largest layer separation" if separation > 0.0 else "the largest displacement"
     unit = f" {length}" if length else ""
-    ax.set_title(f"section {'xyz'[axis]} = {value:.4g}{unit} through {where}; displacements × {scale:.3g}\n"
+    ax.set_title(f"section {'xyz'[axis]} = {mesh.nodes[node, axis]:.4g}{unit} through {where}; displacements × {scale:.3g}\n"
                  f"largest separation of two layers: {separation:.3g}{unit}", fontsize=10)
     ax.set_xlabel(axis_label("xyz"[horizontal], length))
     ax.set_ylabel(axis_label("xyz"[vertical], length))
@@ -556,6 +556,7 @@ def plot_zone_maps(path, controller, itf_index: int, maps: list[tuple[str, np.nd
     s = 400.0 * w / w.max() * min(1.0, 50.0 / max(len(blk.conn), 1)) ** 0.5
     from matplotlib.collections import LineCollection
     from matplotlib.lines import Line2D
+    from matplotlib.transforms import offset_copy
 
     corners = controller.mesh_nodes[blk.conn][:, [0, 4, 1, 5, 2, 6, 3, 7, 0], :2]  # element outlines
     n = max(len(maps), 1)
@@ -575,8 +576,9 @@ def plot_zone_maps(path, controller, itf_index: int, maps: list[tuple[str, np.nd
                      fontsize=10)
         handles = [Line2D([], [], ls="", marker="o", ms=7, color=c, label=f"{lab} ({k} points)")
                    for c, lab, k in (("0.75", "bonded", int((~rel).sum())), ("tab:red", "debonded", int(rel.sum())))]
-        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=2, fontsize=8,
-                  frameon=False)
+        below_label = offset_copy(ax.transAxes, fig=fig, y=-34, units="points")  # under the x label
+        ax.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below_label,
+                  ncol=2, fontsize=8, frameon=False)
     fig.tight_layout()
     return _save(fig, path)
 
