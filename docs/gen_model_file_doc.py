@@ -49,6 +49,10 @@ SECTIONS = [
     ("[steps]", schema.Steps, "Load stepping and Newton settings."),
     ("[[probes]]", schema.ProbeDef, "Named scalar outputs, one value per converged step."),
     ("[[profiles]]", schema.ProfileDef, "A stress component through the thickness at a point."),
+    ("[[lines]]", schema.LineDef,
+     "Components of a displacement, stress or traction along a polyline on the reference surface, at the last "
+     "converged step: line_<name>.csv (distance along the line s, the point x, y, z, one column per component; "
+     "empty where the layer is absent) and line_<name>.png."),
     ("[[plots]]", schema.PlotDef,
      "A figure plot_<name>.png of one probe against another (e.g. load in kN/m² against deflection in mm)."),
     ("[[interfaces]]", schema.InterfaceDef, "Delamination and friction at the interface below a layer."),

@@ -835,6 +835,10 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
             raise pending
         if rcd is not None and spec.profiles and summary["steps"]:
             summary["profiles"] = write_profiles(spec, problem, u, rcd, float(summary["steps"][-1]["load_factor"]))
+        if rcd is not None and spec.lines and summary["steps"]:
+            from .io.lines import write_lines
+
+            summary["lines"] = write_lines(spec, problem, u, rcd, float(summary["steps"][-1]["load_factor"]))
         if rcd is not None:
             rcd.summary(summary, force=True)
             if spec.output.plots:

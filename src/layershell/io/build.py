@@ -72,6 +72,7 @@ class RunSpec:
     source: schema.ModelFile
     path: Path | None = None
     profiles: list = field(default_factory=list)
+    lines: list = field(default_factory=list)  # io.lines.Line
     warnings: list[str] = field(default_factory=list)  # input that is valid but almost surely not meant
     path_following: object = None  # solver.arclength.PathSettings ([steps] control/adaptive), None: fixed steps
 
@@ -1129,6 +1130,9 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              f"{[*STRESS_COMPONENTS, 'p1', 'p2', 'p3', 'von_mises']}")
     spec = RunSpec(model, lf, newton, probes, mf.output, mf)
     spec.profiles = list(mf.profiles)
+    from .lines import build_lines
+
+    spec.lines = build_lines(mf, model, index)
     spec.warnings = notes
     spec.path_following = _path_settings(st, model)
     return spec

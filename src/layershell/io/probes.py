@@ -11,6 +11,9 @@ from ..results import PointState, evaluate_points, locate
 
 STRESS_COMPONENTS = {"11": (0, 0), "22": (1, 1), "33": (2, 2), "23": (1, 2), "13": (0, 2), "12": (0, 1)}
 TRACTION_COMPONENTS = ("13", "23", "33", "shear")
+FIELD_COMPONENTS = {"displacement": ("x", "y", "z", "magnitude"),
+                    "stress": tuple(STRESS_COMPONENTS) + ("p1", "p2", "p3", "von_mises"),
+                    "traction": TRACTION_COMPONENTS}
 
 
 class ProbeError(ValueError):
@@ -51,27 +54,7 @@ class Probe:
 
     def samples(self, model, dm, u, load_factor: float = 1.0) -> np.ndarray:
         ps = self.points(model, dm, u, load_factor)
-        c = self.component
-        if self.quantity == "displacement":
-            vals = np.linalg.norm(ps.u, axis=1) if c == "magnitude" else ps.u[:, "xyz".index(c)]
-        elif self.quantity == "traction":
-            t = ps.traction(self.frame)
-            if c == "shear":  # the tangential part (frame-independent)
-                tm = ps.traction()
-                vals = np.hypot(tm[:, 0], tm[:, 1])
-            else:
-                vals = t[:, {"13": 0, "23": 1, "33": 2}[c]]
-        else:
-            T = ps.stress(self.measure, self.frame)
-            if c in STRESS_COMPONENTS:
-                i, j = STRESS_COMPONENTS[c]
-                vals = T[:, i, j]
-            elif c in ("p1", "p2", "p3"):
-                vals = np.linalg.eigvalsh(T)[:, ::-1][:, int(c[1]) - 1]
-            else:  # von_mises
-                dev = T - np.trace(T, axis1=1, axis2=2)[:, None, None] / 3 * np.eye(3)
-                vals = np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
-        return self.scale * vals
+        return self.scale * component_values(ps, self.quantity, self.component, self.measure, self.frame)
 
     def debonded_area(self, interfaces, whole: bool = False) -> float:
         """Released area of the interfaces below ``layer`` (points selected by ``where``);
@@ -195,6 +178,26 @@ class Probe:
         if self.reduce == "mean":
             return float(v.mean())
         return float(v[0])
+
+
+def component_values(ps: PointState, quantity: str, c: str, measure: str = "cauchy",
+                     frame: str = "material") -> np.ndarray:
+    """One component of a displacement, stress or traction at every point of ``ps``."""
+    if quantity == "displacement":
+        return np.linalg.norm(ps.u, axis=1) if c == "magnitude" else ps.u[:, "xyz".index(c)]
+    if quantity == "traction":
+        if c == "shear":  # the tangential part (frame-independent)
+            tm = ps.traction()
+            return np.hypot(tm[:, 0], tm[:, 1])
+        return ps.traction(frame)[:, {"13": 0, "23": 1, "33": 2}[c]]
+    T = ps.stress(measure, frame)
+    if c in STRESS_COMPONENTS:
+        i, j = STRESS_COMPONENTS[c]
+        return T[:, i, j]
+    if c in ("p1", "p2", "p3"):
+        return np.linalg.eigvalsh(T)[:, ::-1][:, int(c[1]) - 1]
+    dev = T - np.trace(T, axis1=1, axis2=2)[:, None, None] / 3 * np.eye(3)  # von_mises
+    return np.sqrt(1.5 * np.einsum("pij,pij->p", dev, dev))
 
 
 def residual_forces(model, dm, u: np.ndarray, load_factor: float, problem=None) -> np.ndarray:
@@ -321,9 +324,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         comp = pd.component
         if comp is None:
             raise InputError(f"'{f}.component': a {pd.quantity} probe needs a component")
-        allowed = {"displacement": ("x", "y", "z", "magnitude"),
-                   "stress": tuple(STRESS_COMPONENTS) + ("p1", "p2", "p3", "von_mises"),
-                   "traction": TRACTION_COMPONENTS}[pd.quantity]
+        allowed = FIELD_COMPONENTS[pd.quantity]
         if comp not in allowed:
             raise InputError(f"'{f}.component': '{comp}' is not a {pd.quantity} component; use one of {list(allowed)}")
         if isinstance(pd.theta3, list):

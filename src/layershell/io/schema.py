@@ -612,6 +612,40 @@ class ProfileDef(Strict):
     points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer")
 
 
+class LineDef(Strict):
+    """A displacement, stress or traction component along a polyline on the reference surface:
+    line_<name>.csv (distance along the line s, the point x, y, z, one column per component) and
+    line_<name>.png, at the last converged step."""
+
+    name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description=(
+        "file names line_<name>.csv / .png"))
+    points: list[Vec3] = Field(min_length=2, description=(
+        "vertices [x, y, z] of the polyline on the reference surface (model coordinates), e.g. [[0, 0.5, 0], "
+        "[4, 0.5, 0]] along a span; on a curved shell close enough that each straight segment stays within 5 % "
+        "of its length of the surface"))
+    samples: int = Field(21, ge=2, le=10_000, description=(
+        "sample points per segment, its ends included (a shared vertex once), each moved to the nearest point "
+        "of the reference surface"))
+    quantity: Literal["displacement", "stress", "traction"] = Field(description=(
+        "displacement, stress at theta3, or traction: the interface stresses on the bottom face of `layer`"))
+    components: list[str] = Field(min_length=1, description=(
+        "one CSV column and one curve each: displacement: x|y|z|magnitude; stress: "
+        "11|22|33|23|13|12|p1|p2|p3|von_mises; traction: 13|23|33|shear (as [[probes]])"))
+    theta3: FiniteFloat = Field(0.0, description="displacement, stress: Θ³ from the reference face")
+    layer: str | None = Field(None, description=(
+        "the layer meant (traction: the layer above the interface, required); where [[stacks]] leave it out the "
+        "CSV cells are empty and the curve has a gap"))
+    measure: Literal["cauchy", "pk2"] = Field("cauchy", description="stress measure (as [[probes]])")
+    sampling: Literal["recovered", "raw"] = Field("recovered", description=(
+        "stress/traction: 'recovered' or 'raw' transverse stresses (as [[probes]])"))
+    frame: Literal["material", "global"] = Field("material", description=(
+        "stress/traction components in the material axes or the global x, y, z axes (as [[probes]])"))
+    scale: FiniteFloat = Field(1.0, description="factor on the values (e.g. -1 for a downward deflection)")
+    unit: str | None = Field(None, description=(
+        "unit of the values (after 'scale') on the figure's axis; default: from [model] units (length for "
+        "displacements, force/length² for stresses)"))
+
+
 class InitialZone(Strict):
     """Initially debonded region of an interface: nodes selected by a formula, a set, or a circle."""
 
@@ -745,6 +779,7 @@ class ModelFile(Strict):
     steps: Steps = Steps()
     probes: list[ProbeDef] = []
     profiles: list[ProfileDef] = []
+    lines: list[LineDef] = []
     plots: list[PlotDef] = []
     interfaces: list[InterfaceDef] = []
     delamination: DelaminationDef = DelaminationDef()
