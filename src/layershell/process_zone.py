@@ -15,7 +15,7 @@ smaller applicable one (Harper & Hallett 2008), and :func:`zone_lengths` says wh
   ``1/E'_I = sqrt(a11 a22 / 2) ρ``, ``1/E'_II = a11 ρ / sqrt 2`` (E for an isotropic layer);
   two layers: 2/E' = 1/E'_1 + 1/E'_2 (a rigid one counts 0). M = 1/π (Irwin): the prefactor
   that the zones measured in FE runs follow (tests/test_process_zone.py: DCBs of 1.5, 1.98 and
-  8 mm arms and the ENF measure 0.8-1.2 times this estimate; M = 1 with E3 would be 1.6-3 times
+  8 mm arms and the ENF measure 0.8-1.2 times this estimate; M = 1 with E3 would be 2.2-3 times
   the DCBs' zones and 0.6 times the ENF's);
 * slender layers (the zone is long against them): the layers bend and stretch as beams
   along the crack and the interface is a softening foundation. Yang & Cox (2005) and Harper &
