@@ -75,10 +75,10 @@ def _visible_tick_labels(axis, renderer):
 
 def tick_labels_overlap(axis, renderer) -> bool:
     """Whether two neighbouring tick labels of ``axis`` touch or overlap (a little gap required)."""
-    boxes = _visible_tick_labels(axis, renderer)
+    i = 0 if axis.axis_name == "x" else 1
+    spans = sorted((box.get_points()[0, i], box.get_points()[1, i]) for box in _visible_tick_labels(axis, renderer))
     gap = 2.0  # pixels
-    return any(a.x1 + gap > b.x0 if axis.axis_name == "x" else a.y1 + gap > b.y0
-               for a, b in zip(boxes[:-1], boxes[1:]))
+    return any(a[1] + gap > b[0] for a, b in zip(spans[:-1], spans[1:]))
 
 
 def separate_tick_labels(fig) -> None:
