@@ -329,6 +329,9 @@ def _draw_section(ax, model: Model, dm: DofMap, u_full: np.ndarray, plane, scale
         ax.plot([], [], color=light, lw=6, label=ly.name)
     ax.plot([], [], color="0.7", lw=0.8, ls="--", label="undeformed")
     ax.autoscale_view()
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    if 0.2 <= (y1 - y0) / max(x1 - x0, 1e-300) <= 5.0:  # not a thin strip: true proportions
+        ax.set_aspect("equal", adjustable="datalim")
     ax.legend(fontsize="small", loc="best")
 
 
