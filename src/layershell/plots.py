@@ -343,7 +343,7 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
     largest separation of two layers (else the largest displacement): every layer's deformed bottom
     and top face, so that a layer that lifts off shows as a gap. ``scale=None``: the largest
     displacement is drawn as 10 % of the model size, or as twice the thickness where that is less
-    (not below true scale).
+    (never below 1: large displacements are drawn true to scale).
 
     The colour scale spans the field over the sampled surface (5×5 points per element, nodes
     included). Returns the path, or with ``info`` ``(path, {"field", "scale", "max_u",
@@ -397,15 +397,15 @@ def plot_deformed(path, model: Model, dm: DofMap, u_full: np.ndarray, field: str
 def _default_scale(model: Model, u: np.ndarray, umax: float, vertical: int, separation: float = 0.0) -> float:
     """Magnification: the largest displacement ``umax`` as 10 % of the model size, or the largest
     one along the section's vertical axis (or the largest separation of two layers) as twice the
-    thickness where that is less, not below 1."""
+    thickness where that is less; never below 1 (large displacements are drawn true to scale)."""
     if umax <= 0.0:
         return 1.0
     scale = 0.1 * model.mesh.size() / umax
     across = max(float(np.abs(u[:, vertical]).max()), separation)
     thickness = float(model.total_thickness().max())
     if across > 0.0 and thickness > 0.0:
-        scale = min(scale, max(1.0, 2.0 * thickness / across))
-    return scale
+        scale = min(scale, 2.0 * thickness / across)
+    return max(scale, 1.0)
 
 
 def _draw_surface(ax, fig, model: Model, u: np.ndarray, val: np.ndarray, label: str, scale: float,
