@@ -590,6 +590,33 @@ def _safe(name: str) -> str:
     return "".join(c if c.isalnum() or c in "-_" else "_" for c in name)
 
 
+def _thickness_figures(out: Path, spec, problem, u: np.ndarray, summary: dict, through_thickness) -> dict:
+    """thickness_<probe>.png of every stress probe at a point (last converged step): the
+    component through all layers against the physical height, the probe's own value marked."""
+    from types import SimpleNamespace
+
+    model = spec.model
+    lam = summary["steps"][-1]["load_factor"]
+    files = {}
+    for pd in spec.source.probes:
+        if pd.quantity != "stress" or pd.point is None:
+            continue
+        prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21,
+                               sampling=pd.sampling, frame=pd.frame)
+        cols = through_thickness(prof, model, problem.dm, u, lam)
+        f = f"thickness_{_safe(pd.name)}.png"
+        mark = None
+        if isinstance(pd.theta3, (int, float)) and pd.reduce == "none" and pd.scale:
+            mark = (float(summary["probes"][pd.name]) / pd.scale, float(pd.theta3))
+        plot_through_thickness(out / f, {k: (v, t) for k, (t, v) in cols.items()},
+                               axis_label(f"{pd.measure} σ{pd.component} at {tuple(pd.point)} (λ = {lam:.4g})",
+                                          Units.parse(model.units).stress), mark=mark,
+                               title=f"probe {pd.name}", height=height_axis(model, pd.point))
+        vals = np.concatenate([v for _, v in cols.values()])
+        files[f] = {"probe": pd.name, "range": (float(vals.min()), float(vals.max()))}
+    return files
+
+
 def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneHistory | None = None,
                   through_thickness=None) -> dict:
     """All PNG figures of a run, written into ``out`` (called once after the last step).
@@ -637,26 +664,8 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
 
     files["deformed.png"] = plot_deformed(out / "deformed.png", model, problem.dm, u, info=True)[1]
 
-    for pd in spec.source.probes:
-        if pd.quantity != "stress" or pd.point is None:
-            continue
-        from types import SimpleNamespace
-
-        if through_thickness is None:  # the sampler is handed in (runner.through_thickness): no import circle
-            continue
-        prof = SimpleNamespace(point=pd.point, component=pd.component, measure=pd.measure, points_per_layer=21,
-                               sampling=pd.sampling, frame=pd.frame)
-        cols = through_thickness(prof, model, problem.dm, u, lam[-1])
-        f = f"thickness_{_safe(pd.name)}.png"
-        mark = None
-        if isinstance(pd.theta3, (int, float)) and pd.reduce == "none" and pd.scale:
-            mark = (float(summary["probes"][pd.name]) / pd.scale, float(pd.theta3))
-        plot_through_thickness(out / f, {k: (v, t) for k, (t, v) in cols.items()},
-                               axis_label(f"{pd.measure} σ{pd.component} at {tuple(pd.point)} (λ = {lam[-1]:.4g})",
-                                          Units.parse(model.units).stress), mark=mark,
-                               title=f"probe {pd.name}", height=height_axis(model, pd.point))
-        vals = np.concatenate([v for _, v in cols.values()])
-        files[f] = {"probe": pd.name, "range": (float(vals.min()), float(vals.max()))}
+    if through_thickness is not None:  # the sampler is handed in (runner.through_thickness): no import circle
+        files.update(_thickness_figures(out, spec, problem, u, summary, through_thickness))
 
     ctl = problem.interfaces
     if ctl is not None and zones is not None and zones.steps:
