@@ -1,15 +1,16 @@
 """Physical units of the quantities on figure axes, derived from ``[model] units``.
 
-``units`` names a force and a length unit (e.g. ``"kN, m"``, ``"N, mm"``; the order is free
-when both are recognised, else force first). Stresses and tractions are then force/length²,
-line loads and energy per area force/length, moments force·length, areas length².
+``units`` names a force and a length unit, in either order (e.g. ``"kN, m"``, ``"N, mm"``).
+Stresses and tractions are then force/length², line loads and energy per area force/length,
+moments force·length, areas length².
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-#: length units recognised in either position of ``units`` (anything else: force first, length second)
-LENGTH_UNITS = frozenset({"m", "dm", "cm", "mm", "µm", "um", "km", "in", "ft"})
+#: the length and force units that ``[model] units`` may name
+LENGTH_UNITS = ("m", "dm", "cm", "mm", "µm", "um", "km", "in", "ft")
+FORCE_UNITS = ("N", "mN", "daN", "kN", "MN", "GN", "lbf", "kip")
 
 
 @dataclass(frozen=True)
@@ -25,8 +26,10 @@ class Units:
         if len(parts) != 2:
             return cls()
         force, length = parts
-        if force in LENGTH_UNITS and length not in LENGTH_UNITS:
+        if force in LENGTH_UNITS and length in FORCE_UNITS:
             force, length = length, force
+        if force not in FORCE_UNITS or length not in LENGTH_UNITS:
+            return cls()
         return cls(force, length)
 
     @property
@@ -72,6 +75,16 @@ class Units:
         if quantity == "resultant":
             return self.moment_per_width if component.startswith("m") else self.per_length
         return ""
+
+
+def check_units(text: str) -> str:
+    """``text`` if it is empty or names a force and a length unit; else ValueError with the fix."""
+    if text.strip() and not Units.parse(text).known:
+        raise ValueError(
+            f"'{text}' does not name a force and a length unit: give 'force, length' with a force unit of "
+            f"{', '.join(FORCE_UNITS)} and a length unit of {', '.join(LENGTH_UNITS)} (e.g. 'kN, m' or 'N, mm'); "
+            "stresses are then labelled force/length²")
+    return text
 
 
 def axis_label(name: str, unit: str | None) -> str:
