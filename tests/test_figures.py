@@ -436,3 +436,21 @@ def test_profiles_against_the_physical_height(monkeypatch, tmp_path):
 
     flipped = _spec(SUCTION.replace('ny = 1\n', 'ny = 1\nnormal = "-z"\n', 1)).model
     assert height_axis(flipped, [1.0, 0.5, 0.0]) == (0.0, -1.0, "height z [m]")
+
+
+def test_units_that_name_no_force_and_length_are_refused(tmp_path):
+    """`[model] units` gives the axes their units, so a string that names no force and length unit
+    ("MPa, mm": a stress) is an input error (exit 2) naming the field and the units accepted."""
+    from typer.testing import CliRunner
+
+    from layershell.cli import app
+
+    model = tmp_path / "strip.toml"
+    model.write_text(STRIP.replace('units = "N, mm"', 'units = "MPa, mm"'), encoding="utf-8")
+    res = CliRunner().invoke(app, ["check", str(model)], env={"NO_COLOR": "1"})
+    assert res.exit_code == 2, res.output
+    text = res.output + getattr(res, "stderr", "")
+    assert "model.units" in text and "'MPa, mm'" in text and "'kN, m' or 'N, mm'" in text
+    assert res.exception is None or isinstance(res.exception, SystemExit)  # no traceback
+    model.write_text(STRIP.replace('units = "N, mm"', 'units = "mm, N"'), encoding="utf-8")
+    assert CliRunner().invoke(app, ["check", str(model)], env={"NO_COLOR": "1"}).exit_code == 0
