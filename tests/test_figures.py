@@ -281,7 +281,7 @@ def test_units_derived_from_the_unit_system():
 
     u = Units.parse("N, mm")
     assert (u.force, u.length, u.stress, u.per_length, u.area) == ("N", "mm", "N/mm²", "N/mm", "mm²")
-    assert Units.parse("m, kN") == Units.parse("kN, m") == Units("kN", "m")
+    assert Units.parse("m, kN") == Units.parse("kN, m") == Units.parse("kN m") == Units("kN", "m")
     assert Units.parse("kN, m").of_probe("stress", "11") == "kN/m²"
     assert Units.parse("kN, m").of_probe("traction", "33") == "kN/m²"
     assert Units.parse("kN, m").of_probe("debonded_area") == "m²"

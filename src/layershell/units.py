@@ -1,11 +1,12 @@
 """Physical units of the quantities on figure axes, derived from ``[model] units``.
 
-``units`` names a force and a length unit, in either order (e.g. ``"kN, m"``, ``"N, mm"``).
-Stresses and tractions are then force/length², line loads and energy per area force/length,
-moments force·length, areas length².
+``units`` names a force and a length unit, in either order, apart by a comma, semicolon or space
+(e.g. ``"kN, m"``, ``"N, mm"``). Stresses and tractions are then force/length², line loads and
+energy per area force/length, moments force·length, areas length².
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 
 #: the length and force units that ``[model] units`` may name
@@ -22,7 +23,7 @@ class Units:
 
     @classmethod
     def parse(cls, text: str | None) -> Units:
-        parts = [p.strip() for p in (text or "").replace(";", ",").split(",") if p.strip()]
+        parts = re.split(r"[,;\s]+", (text or "").strip()) if (text or "").strip() else []
         if len(parts) != 2:
             return cls()
         force, length = parts
