@@ -454,3 +454,18 @@ def test_units_that_name_no_force_and_length_are_refused(tmp_path):
     assert res.exception is None or isinstance(res.exception, SystemExit)  # no traceback
     model.write_text(STRIP.replace('units = "N, mm"', 'units = "mm, N"'), encoding="utf-8")
     assert CliRunner().invoke(app, ["check", str(model)], env={"NO_COLOR": "1"}).exit_code == 0
+
+
+def test_calibration_axes_in_physical_units(monkeypatch, tmp_path):
+    """calibration.png: the fitted curve's axes carry the probes' units (N, mm), as the run's figures."""
+    from layershell.calibrate import Param, calibrate
+
+    model = tmp_path / "strip.toml"
+    model.write_text(STRIP, encoding="utf-8")
+    data = tmp_path / "data.csv"
+    data.write_text("u_end,N\n0.25,6\n0.5,12\n", encoding="utf-8")
+    figs = _Figures(monkeypatch)
+    calibrate(model, data, "u_end", "N", [Param("materials.m.E", 500.0, 2000.0, 1000.0)], tmp_path / "cal",
+              max_runs=2, best_run=False)
+    (ax,) = figs.saved["calibration.png"]
+    assert (ax["xlabel"], ax["ylabel"]) == ("u_end [mm]", "N [N]")

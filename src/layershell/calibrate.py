@@ -297,7 +297,8 @@ def calibrate(model: str | Path, data: str | Path, x: str, y: str, params: list[
     write_csv(out / "calibration.csv", [x, y, f"{y}_start", f"{y}_best"],
               [[float(a), float(b), float(c), float(d)] for a, b, c, d in zip(dxy[0], dxy[1], sx, bx)])
     try:
-        plot_calibration(out / "calibration.png", dxy, start, best, x, y)
+        plot_calibration(out / "calibration.png", dxy, start, best,
+                         *_axis_labels(build_spec(with_values(doc, best["values"]), model.parent, str(model)), x, y))
     except ImportError:  # matplotlib missing: the JSON and CSV are the result
         pass
     if best_run:
@@ -308,6 +309,17 @@ def calibrate(model: str | Path, data: str | Path, x: str, y: str, params: list[
 
 def _finite(v: float) -> float:
     return v if math.isfinite(v) else 1e300
+
+
+def _axis_labels(spec, *names: str) -> list[str]:
+    """``names`` (curve quantities) with their units from the model's ``[model] units``."""
+    from .plots import probe_units
+    from .units import Units, axis_label
+
+    units = probe_units(spec)
+    area = Units.parse(spec.model.units).area
+    return [axis_label(n, area if n.split(":", 1)[0] == "debonded_area" and n not in units else units.get(n, ""))
+            for n in names]
 
 
 def plot_calibration(path: Path, data_xy, start: dict, best: dict, x: str, y: str) -> Path:
