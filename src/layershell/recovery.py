@@ -33,7 +33,9 @@ Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recov
 Assumptions (documented in docs/user-guide.md): small strains (PK2 in the undeformed frame),
 curvature terms of the shear equations neglected (error O(h/R)), applied tractions on the
 'reference' and 'top' faces only (volume loads, loads on interior faces and the divergence of
-tangential face loads are not included), the stack bonded through the thickness. The stress
+tangential face loads are not included), the stack bonded through the thickness and the same
+on all elements of a patch (within LAYER_END_RINGS element rings of a layer end the raw
+transverse stresses are returned, :func:`layer_end_elements`). The stress
 tensor returned replaces the transverse components (σ_i3 in the frame t_1, t_2, A_3) of the raw
 one; in-plane components stay raw. Validation: tests/test_recovery.py (exact 3D solution of a
 [0/90/0] plate, layershell.analytic.pagano) and tests/test_layers.py (Girkmann's curved beam).
@@ -332,6 +334,90 @@ def _at_points(N: np.ndarray, nodal: np.ndarray) -> np.ndarray:
     return np.matmul(N[:, None], nodal.reshape(p, 9, -1))[:, 0].reshape((p,) + nodal.shape[2:])
 
 
+#: Element rings around a layer end in which the recovered transverse stresses are replaced by
+#: raw ones: σ33 takes second in-plane derivatives of patch fits that reach over two rings of
+#: elements and smooth over the change of the stack. On the plated strip of
+#: tests/test_recovery_layer_end.py (1 mm elements) the recovered peel stress 2 elements from the
+#: plate end is 9 % below the closed form (raw: 4 % above), 3 elements from it 2 % below (raw: 3 %
+#: above).
+LAYER_END_RINGS = 3
+
+
+def layer_end_nodes(model: Model) -> np.ndarray:
+    """Nodes shared by elements that carry different sets of layers (where a layer of a
+    ``[[stacks]]`` region ends inside the mesh)."""
+    E = model.mesh.elements
+    sig = {}
+    stack_id = np.array([sig.setdefault(tuple(sorted(model.stacks[s])), len(sig)) for s in range(len(model.stacks))])
+    ids = np.repeat(stack_id[model.element_stack], 9)
+    lo = np.full(model.mesh.n_nodes, np.iinfo(np.int64).max)
+    hi = np.full(model.mesh.n_nodes, -1)
+    np.minimum.at(lo, E.ravel(), ids)
+    np.maximum.at(hi, E.ravel(), ids)
+    return np.flatnonzero((hi >= 0) & (lo != hi))
+
+
+def layer_end_elements(model: Model, rings: int = LAYER_END_RINGS) -> np.ndarray:
+    """Mask of the elements within ``rings`` element rings of a layer end (:func:`layer_end_nodes`):
+    ring 1 holds the elements at such a node, ring r + 1 the elements sharing a node with ring r."""
+    E = model.mesh.elements
+    near = np.zeros(model.mesh.n_nodes, bool)
+    near[layer_end_nodes(model)] = True
+    mask = np.zeros(len(E), bool)
+    for _ in range(rings):
+        mask = near[E].any(axis=1)
+        near[E[mask].ravel()] = True
+    return mask
+
+
+class RecoveryWarning(UserWarning):
+    """Recovered transverse stresses asked for where raw ones are given (next to layer ends)."""
+
+
+def _span_text(X: np.ndarray) -> str:
+    names = "xyz"
+    return ", ".join(f"{names[i]} {X[:, i].min():.6g} to {X[:, i].max():.6g}" for i in range(3)
+                     if X[:, i].max() > X[:, i].min())
+
+
+def raw_fallback_warning(model: Model, probes=(), profiles=(), vtu: bool = False,
+                         criterion: bool = False) -> str | None:
+    """The warning of a run whose outputs ask for recovered transverse stresses in elements next
+    to a layer end (:func:`layer_end_elements`), where :meth:`Recovery.points` gives raw ones:
+    ``probes`` and ``profiles`` with sampling 'recovered', ``vtu`` the ParaView files with
+    [output] sampling = 'recovered', ``criterion`` the delamination criterion with
+    [delamination] stresses = 'recovered'. None where no output is concerned."""
+    mask = layer_end_elements(model)
+    if not mask.any():
+        return None
+    from .results import locate
+
+    in_plane = ("11", "22", "12")  # components the recovery leaves raw anyway
+    users = [f"probe '{p.name}'" for p in probes
+             if (p.quantity == "traction" or p.quantity == "stress" and p.component not in in_plane)
+             and getattr(p, "sampling", "recovered") == "recovered" and mask[np.asarray(p.elements, np.int64)].any()]
+    users += [f"profile '{pr.name}'" for pr in profiles
+              if pr.component not in in_plane and getattr(pr, "sampling", "recovered") == "recovered"
+              and mask[locate(model, pr.point)[0]]]
+    if vtu:
+        users.append("the ParaView files ([output] sampling)")
+    if criterion:
+        users.append("the delamination criterion ([delamination] stresses)")
+    if not users:
+        return None
+    ends = layer_end_nodes(model)
+    E = model.mesh.elements
+    sets = [set(model.stacks[s]) for s in model.element_stack[np.unique(np.flatnonzero(np.isin(E, ends).any(1)))]]
+    ending = sorted(set.union(*sets) - set.intersection(*sets))
+    names = ", ".join(f"'{model.layers[k].name}'" for k in ending)
+    centres = model.mesh.nodes[E[mask]].mean(axis=1)
+    return (f"transverse stresses σ13, σ23, σ33 are raw values (from the displacement derivatives), not "
+            f"recovered ones, in the {int(mask.sum())} elements within {LAYER_END_RINGS} element rings of the "
+            f"end of layer(s) {names} (element centres at {_span_text(centres)}): the recovery integrates the "
+            f"equilibrium through a stack that changes there; this concerns {', '.join(users)}. The raw values "
+            f"converge with elements refined towards the layer end")
+
+
 @dataclass
 class RecoveryFields:
     """Nodal fields of one displacement state: per layer k, the SPR-smoothed stress (Voigt,
@@ -372,6 +458,9 @@ class Recovery:
             spn = surface_points(model.mesh.nodes[E[at_edge]], NODE_XI[:, 0], NODE_XI[:, 1]) if at_edge.size else None
             self._geometry[k] = (els, surface_points(model.mesh.nodes[E[els]], pts[:, 0], pts[:, 1]), at_edge, spn)
         self._cache: tuple | None = None
+        # next to a layer end the through-thickness equilibrium of smoothed fields does not hold:
+        # raw transverse stresses there (points())
+        self.raw_elements = layer_end_elements(model)
 
     # -- nodal fields -------------------------------------------------------------------
     def fields(self, u: np.ndarray) -> RecoveryFields:
@@ -584,6 +673,8 @@ class Recovery:
         vt = vec - np.einsum("pi,pi->p", vec, n)[:, None] * n
         S_rec = (S_in + np.einsum("pi,pj->pij", vt, n) + np.einsum("pi,pj->pij", n, vt)
                  + np.einsum("p,pi,pj->pij", np.einsum("pi,pi->p", vec, n), n, n))
+        raw = self.raw_elements[elements]
+        S_rec[raw] = S[raw]
         sig = cauchy_stress(ps.F, S_rec)
         return replace(ps, S=S_rec, sigma=sig)
 

@@ -587,6 +587,13 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
             rcd.register([f"{k}.pvd" for k in pvd.series])
         log(f"layershell {_version()} run of {spec.path} ({summary['n_elements']} elements, {summary['n_dofs']} "
             f"DOFs, {n_steps} load step(s))" + (f", restarted after step {step0}" if ck is not None else ""))
+    from .recovery import RecoveryWarning, raw_fallback_warning
+
+    raw_note = raw_fallback_warning(
+        model, spec.probes, spec.profiles, vtu=pvd is not None and spec.output.sampling == "recovered",
+        criterion=getattr(getattr(ctl, "settings", None), "stresses", "raw") == "recovered")
+    if raw_note is not None:
+        _warn(summary, raw_note, RecoveryWarning, log)
     resolves = {"n": 0}
     live = {"step": step0 + 1, "load_factor": lam0}
     last = ck  # the state of the last converged step (written again when the run stops)
