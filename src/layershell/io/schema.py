@@ -65,8 +65,9 @@ class Strict(BaseModel):
 class ModelSettings(Strict):
     title: str = Field("", description="title shown in the report and the figures")
     units: str = Field("", description=(
-        "force and length unit, 'force, length' (e.g. 'kN, m'): names the units of the report and the figure axes "
-        "(stresses force/length², resultants force/length, areas length²); nothing is converted"))
+        "'force, length' (e.g. 'kN, m', 'N, mm'; force N, mN, daN, kN, MN, GN, lbf or kip; length m, dm, cm, "
+        "mm, µm, um, km, in or ft): names the units of the report and the figure axes (stresses force/length², "
+        "resultants force/length, areas length²); nothing is converted"))
     nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
     thickness_points: PositiveInt = Field(
         3, le=10, description="Gauss points through each layer (at least d are used: d = 4 needs 4)")
@@ -74,6 +75,13 @@ class ModelSettings(Strict):
         "mitc", description="shell element: 'mitc' = assumed-strain MITC9 (membrane and transverse shear "
                             "strains tied, no locking in thin shells; at least d + 1 thickness points), "
                             "'full' = the fully integrated 9-node element (locks in thin shells; for comparison)")
+
+    @field_validator("units")
+    @classmethod
+    def _units(cls, v):
+        from ..units import check_units
+
+        return check_units(v)
 
 
 # ------------------------------------------------------------------ meshes
