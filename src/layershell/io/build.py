@@ -1133,6 +1133,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     from .lines import build_lines
 
     spec.lines = build_lines(mf, model, index)
-    spec.warnings = notes
+    from .material_axes import material_axis_notes
+
+    spec.warnings = notes + material_axis_notes(model, mf.mesh.type)
     spec.path_following = _path_settings(st, model)
     return spec
