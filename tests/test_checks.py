@@ -77,7 +77,10 @@ tau_max = 80.0
 """
 
 
-def _check(tmp_path: Path, nx: int = 200, support: str = 'layer = "lower"', interface: str = COHESIVE) -> str:
+PUSHED = 'layer = "lower"\ncomponents = ["x", "y", "z"]\nvalue = [0.5, 0.0, 0.0]'  # pulled along the strip
+
+
+def _check(tmp_path: Path, nx: int = 200, support: str = PUSHED, interface: str = COHESIVE) -> str:
     (tmp_path / "strip.toml").write_text(STRIP.format(nx=nx, support=support, interface=interface))
     res = CliRunner().invoke(app, ["check", str(tmp_path / "strip.toml")])
     assert res.exit_code == 0, res.output
@@ -91,10 +94,11 @@ def _warnings(text: str, what: str) -> list[str]:
 
 @pytest.mark.parametrize("interface, law", [(COHESIVE, "cohesive"), (STRESS, "stress criterion")])
 def test_support_on_one_layer_names_the_layer_it_does_not_hold(tmp_path, interface, law):
-    """The end x = 0 clamped on the lower layer only: the upper layer is there, connected to it only
-    through the interface, and no support holds it: a warning names the support, the layer it
-    does not hold, the interface and its law, and the fix (layer = "all" or a support on the
-    upper layer). Before, `check` said OK and nothing else."""
+    """The end x = 0 pulled along the strip by a prescribed displacement of the lower layer only:
+    the upper layer is there, connected to it only through the interface, and no support holds
+    it: a warning names the support, the layer it does not hold, the interface and its law, and
+    the fix (layer = "all" or a support on the upper layer). Before, `check` said OK and nothing
+    else."""
     text = _check(tmp_path, interface=interface)
     w = _warnings(text, "do(es) not hold")
     assert len(w) == 1, text
@@ -104,11 +108,16 @@ def test_support_on_one_layer_names_the_layer_it_does_not_hold(tmp_path, interfa
 
 
 @pytest.mark.parametrize("support", [
-    'layer = "all"',  # every layer held
-    'layer = "lower"\n\n[[supports]]\ntype = "fix"\nwhere = "near(x, 0)"\nlayer = "upper"',  # a support per layer
+    PUSHED.replace('"lower"', '"all"'),  # every layer moved
+    PUSHED + '\n\n[[supports]]\ntype = "fix"\nwhere = "near(x, 0)"\nlayer = "upper"\ncomponents = ["x", "y", "z"]\n'
+             'value = [0.5, 0.0, 0.0]',  # a support per layer
+    'layer = "lower"',  # a clamp on one layer (the set-up of the thesis's plates): no shear pushed in
+    'layer = "lower"\ncomponents = ["z"]\nvalue = [0.5]',  # moved along the normal only (a DCB arm)
 ])
 def test_support_that_holds_every_layer_gives_no_warning(tmp_path, support):
-    """The same clamp on all layers, or one support per layer, holds the whole stack: no warning."""
+    """The same prescribed displacement on all layers or one per layer moves the whole stack; a
+    clamp at zero or a displacement along the normal pushes no shear into the interface: no
+    warning."""
     assert not _warnings(_check(tmp_path, support=support), "do(es) not hold")
 
 

@@ -4,7 +4,9 @@ likely to do what the model means.
 * :func:`unheld_layer_warnings`: a support on one layer holds the layers that are bonded to it;
   a layer that is connected to it only through a cohesive interface keeps its own displacements
   there and is held only by the interface's tractions (through a stress-criterion interface, only
-  until it debonds).
+  until it debonds). Only supports that move their layer along the surface (a non-zero prescribed
+  displacement with a tangential part) are named: they shear the interface where they push or
+  pull; a clamp or bearing on one layer is the set-up of most specimens and plates.
 * :func:`process_zone_warnings`: the cohesive process zone (:mod:`layershell.process_zone`)
   against the node spacing of the mesh (at least 3 node spacings, Turon et al. 2007).
 """
@@ -33,6 +35,34 @@ def _present(model: Model) -> np.ndarray:
         nodes = np.unique(model.mesh.elements[model.element_stack == si])
         on[np.ix_(list(st), nodes)] = True
     return on
+
+
+def _normals(model: Model) -> np.ndarray:
+    """(n_nodes, 3) unit normals of the reference surface at the nodes."""
+    from .io.build import nodal_normals
+
+    return nodal_normals(model.mesh)
+
+
+def _moves_tangentially(support, normals: np.ndarray) -> bool:
+    """Whether a support prescribes a non-zero displacement in a direction with a part in the
+    tangent plane (a fixture that pushes or pulls its layer along the surface shears an interface
+    above it; a bearing along the normal, or a support held at zero, is the test set-up of most
+    specimens and plates and is not named)."""
+    value = getattr(support, "value", None)
+    if value is None:
+        return False
+    n = normals[np.asarray(support.nodes)]
+    if hasattr(support, "components"):
+        moving = [c for c, v in zip(support.components, value) if v != 0.0]
+        if not moving:
+            return False
+        along = np.abs(n @ np.eye(3)[moving].T)  # (m, c)
+    else:
+        if not np.any(np.asarray(value) != 0.0):
+            return False
+        along = np.abs(np.einsum("mi,mi->m", n, np.asarray(support.direction)))[:, None]
+    return bool(np.any(along < 0.99))
 
 
 def _support_names(spec, nodes: np.ndarray) -> str:
@@ -79,7 +109,10 @@ def unheld_layer_warnings(spec) -> list[str]:
     for c in supports:
         held[np.ix_(group == group[c.layer], np.asarray(c.nodes))] = True
     found: dict[tuple[int, int], list] = {}  # (supported layer, group not held) -> [(nodes, free)]
+    normals = _normals(model)
     for c in supports:
+        if not _moves_tangentially(c, normals):
+            continue
         nodes = np.asarray(c.nodes)
         for g in np.unique(group[group != group[c.layer]]):
             free = present[group == g][:, nodes].any(axis=0) & ~held[np.flatnonzero(group == g)[0], nodes]
