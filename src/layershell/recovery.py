@@ -35,8 +35,9 @@ curvature terms of the shear equations neglected (error O(h/R)), applied tractio
 'reference' and 'top' faces only (volume loads, loads on interior faces and the divergence of
 tangential face loads are not included), the stack bonded through the thickness and the same
 on all elements of a patch (within LAYER_END_RINGS element rings of a layer end the raw
-transverse stresses are returned, :func:`layer_end_elements`). The stress
-tensor returned replaces the transverse components (σ_i3 in the frame t_1, t_2, A_3) of the raw
+transverse stresses are returned, :func:`layer_end_elements`), reactions of supports through
+the thickness only (within one laminate thickness of a support on a face the raw ones are
+returned, :func:`face_support_elements`). The stress tensor returned replaces the transverse components (σ_i3 in the frame t_1, t_2, A_3) of the raw
 one; in-plane components stay raw. Validation: tests/test_recovery.py (exact 3D solution of a
 [0/90/0] plate, layershell.analytic.pagano) and tests/test_layers.py (Girkmann's curved beam).
 """
@@ -370,6 +371,62 @@ def layer_end_elements(model: Model, rings: int = LAYER_END_RINGS) -> np.ndarray
     return mask
 
 
+def face_support_nodes(model: Model) -> np.ndarray:
+    """Nodes where a support bears normally (holds the displacement along the normal) on a face
+    or at a height rather than through the thickness: a support with face or height (a tie
+    mixing directors), a hinge, or a fix/tie of whole directors that leaves some director 1..d
+    of a layer free (e.g. only u_0, the layer's bottom face; u_0 itself may follow from the bond
+    to the layer below). Their reactions act on a face, which the recovery (integrating from the
+    applied face tractions) does not see. Supports that hold tangential components only (rigid-
+    body restraints, as a rule) are left out."""
+    n = model.mesh.n_nodes
+    E = model.mesh.elements
+    normal = np.zeros((n, 3))
+    np.add.at(normal, E.ravel(), np.repeat(model.mesh.normals_at_centres(), E.shape[1], axis=0))
+    normal /= np.maximum(np.linalg.norm(normal, axis=1, keepdims=True), 1e-300)
+    face = np.zeros(n, bool)
+    held = {}  # layer → bit mask per node of the directors held whole
+
+    def hold(k, nodes, bits):
+        np.bitwise_or.at(held.setdefault(k, np.zeros(n, np.int64)), nodes, bits)
+
+    for fx in model.fixes:
+        nodes = np.asarray(fx.nodes)
+        bears = np.abs(normal[nodes][:, list(fx.components)]).max(axis=1) > 0.5
+        hold(fx.layer, nodes[bears], sum(1 << l for l in set(fx.directors)))
+    for t in model.ties:
+        c = np.asarray(t.coeffs, float)
+        nodes = np.asarray(t.nodes)
+        bears = np.abs(np.einsum("pi,pi->p", np.broadcast_to(t.direction, (nodes.size, 3)), normal[nodes])) > 0.5
+        unit = (np.count_nonzero(c, axis=1) == 1) & np.isclose(np.abs(c).max(axis=1), 1.0)
+        face[nodes[bears & ~unit]] = True
+        hold(t.layer, nodes[bears & unit], 1 << np.argmax(np.abs(c[bears & unit]), axis=1))
+    for k, bits in held.items():
+        upper = (1 << (model.layers[k].directors + 1)) - 2  # directors 1..d
+        face |= (bits > 0) & (bits & upper != upper)
+    for hg in model.hinges:
+        nodes = np.asarray(hg.nodes)
+        face[nodes[np.abs(np.einsum("pi,pi->p", np.broadcast_to(hg.direction, (nodes.size, 3)), normal[nodes])) > 0.5]] = True
+    return np.flatnonzero(face)
+
+
+def face_support_elements(model: Model) -> np.ndarray:
+    """Mask of the elements with a node within one stack thickness (at the support node) of a
+    :func:`face_support_nodes` node: the zone over which a reaction on a face spreads through
+    the thickness."""
+    from scipy.spatial import cKDTree
+
+    sup = face_support_nodes(model)
+    mask = np.zeros(model.mesh.n_elements, bool)
+    if sup.size == 0:
+        return mask
+    X = model.mesh.nodes
+    near = np.zeros(model.mesh.n_nodes, bool)
+    hits = cKDTree(X).query_ball_point(X[sup], model.total_thickness()[sup] * (1 + 1e-9))
+    near[np.concatenate([np.asarray(h, np.int64) for h in hits])] = True
+    return near[model.mesh.elements].any(axis=1)
+
+
 class RecoveryWarning(UserWarning):
     """Recovered transverse stresses asked for where raw ones are given (next to layer ends)."""
 
@@ -382,12 +439,13 @@ def _span_text(X: np.ndarray) -> str:
 
 def raw_fallback_warning(model: Model, probes=(), profiles=(), vtu: bool = False,
                          criterion: bool = False) -> str | None:
-    """The warning of a run whose outputs ask for recovered transverse stresses in elements next
-    to a layer end (:func:`layer_end_elements`), where :meth:`Recovery.points` gives raw ones:
+    """The warning of a run whose outputs ask for recovered transverse stresses where
+    :meth:`Recovery.points` gives raw ones (next to layer ends and supports on a face):
     ``probes`` and ``profiles`` with sampling 'recovered', ``vtu`` the ParaView files with
     [output] sampling = 'recovered', ``criterion`` the delamination criterion with
     [delamination] stresses = 'recovered'. None where no output is concerned."""
-    mask = layer_end_elements(model)
+    at_end, at_support = layer_end_elements(model), face_support_elements(model)
+    mask = at_end | at_support
     if not mask.any():
         return None
     from .results import locate
@@ -405,17 +463,23 @@ def raw_fallback_warning(model: Model, probes=(), profiles=(), vtu: bool = False
         users.append("the delamination criterion ([delamination] stresses)")
     if not users:
         return None
-    ends = layer_end_nodes(model)
     E = model.mesh.elements
-    sets = [set(model.stacks[s]) for s in model.element_stack[np.unique(np.flatnonzero(np.isin(E, ends).any(1)))]]
-    ending = sorted(set.union(*sets) - set.intersection(*sets))
-    names = ", ".join(f"'{model.layers[k].name}'" for k in ending)
-    centres = model.mesh.nodes[E[mask]].mean(axis=1)
+    where = []
+    if at_end.any():
+        ends = layer_end_nodes(model)
+        sets = [set(model.stacks[s]) for s in model.element_stack[np.flatnonzero(np.isin(E, ends).any(1))]]
+        names = ", ".join(f"'{model.layers[k].name}'" for k in sorted(set.union(*sets) - set.intersection(*sets)))
+        centres = model.mesh.nodes[E[at_end]].mean(axis=1)
+        where.append(f"{int(at_end.sum())} elements within {LAYER_END_RINGS} element rings of the end of layer(s) "
+                     f"{names} (element centres at {_span_text(centres)}), where the stack changes")
+    if at_support.any():
+        centres = model.mesh.nodes[E[at_support]].mean(axis=1)
+        where.append(f"{int(at_support.sum())} elements within one laminate thickness of the supports held on a "
+                     f"face or at a height (element centres at {_span_text(centres)}), whose reactions are no "
+                     "applied face tractions")
     return (f"transverse stresses σ13, σ23, σ33 are raw values (from the displacement derivatives), not "
-            f"recovered ones, in the {int(mask.sum())} elements within {LAYER_END_RINGS} element rings of the "
-            f"end of layer(s) {names} (element centres at {_span_text(centres)}): the recovery integrates the "
-            f"equilibrium through a stack that changes there; this concerns {', '.join(users)}. The raw values "
-            f"converge with elements refined towards the layer end")
+            f"recovered ones (equilibrium integrated through the thickness), in {' and in '.join(where)}; this "
+            f"concerns {', '.join(users)}. The raw values converge with elements refined there")
 
 
 @dataclass
@@ -458,9 +522,10 @@ class Recovery:
             spn = surface_points(model.mesh.nodes[E[at_edge]], NODE_XI[:, 0], NODE_XI[:, 1]) if at_edge.size else None
             self._geometry[k] = (els, surface_points(model.mesh.nodes[E[els]], pts[:, 0], pts[:, 1]), at_edge, spn)
         self._cache: tuple | None = None
-        # next to a layer end the through-thickness equilibrium of smoothed fields does not hold:
-        # raw transverse stresses there (points())
-        self.raw_elements = layer_end_elements(model)
+        # next to a layer end the through-thickness equilibrium of smoothed fields does not hold,
+        # nor near a support on a face (its reaction is no applied face traction): raw transverse
+        # stresses there (points())
+        self.raw_elements = layer_end_elements(model) | face_support_elements(model)
 
     # -- nodal fields -------------------------------------------------------------------
     def fields(self, u: np.ndarray) -> RecoveryFields:
