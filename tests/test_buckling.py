@@ -88,7 +88,8 @@ def test_prestress_is_the_linear_state_and_the_stress_stiffness_is_the_tangent_d
 def test_prescribed_shortening_buckles_the_sway_column():
     """The column clamped at both ends, the loaded end free to sway and shortened by the
     prescribed δ = P_E L / (E A) per unit λ (no force): the buckling factor is that of the
-    effective length L, 4 P_E with Engesser's correction, within 1 %."""
+    effective length L, 4 P_E with Engesser's correction, within 1 %; the prestress state is the
+    bar's linear shortening u = −δ x / L."""
     delta = P_EULER * L / (E * B * T)
     text = column_text(8).replace(
         '[[loads]]               # λ = 1: Euler\'s load P_E, uniform through the thickness (N/mm²)\ntype = "edge"\n'
@@ -96,7 +97,12 @@ def test_prescribed_shortening_buckles_the_sway_column():
         f'[[supports]]\ntype = "fix"\nwhere = "near(x, 100)"\ndirectors = "all"\ncomponents = ["x"]\n'
         f'value = [{-delta!r}]\n')
     assert LOADS not in text and "value = [" in text
-    lam = linear_buckling(build(parse(text)).model, 1).load_factors[0]
+    res = linear_buckling(build(parse(text)).model, 1)
+    pb = res.problem
+    x = pb.model.mesh.nodes[:, 0]
+    ux = res.prestress[pb.dm.layer_dofs[0][:, 0, 0]]  # the linear state: u = −δ x / L along the bar
+    assert np.allclose(ux, -delta * x / L, rtol=0, atol=1e-9 * delta), ux
+    lam = res.load_factors[0]
     assert rel(lam, engesser(4 * P_EULER) / P_EULER) < 0.01, lam
 
 
@@ -281,8 +287,8 @@ def test_modes_of_another_mesh_are_refused(column_modes):
 
 
 def test_buckle_refuses_interfaces_and_bad_options(tmp_path):
-    """Interface laws (the analysis is of the bonded stack), a model without loads and --modes 0:
-    exit code 2 with one paragraph, no traceback."""
+    """Interface laws (the analysis is of the bonded stack), a model without loads, --modes 0 and
+    supports that leave a rigid-body motion: exit code 2 with one paragraph, no traceback."""
     itf = (EXAMPLES / "dcb_cohesive.toml").read_text()
     r = buckle(tmp_path, itf, "--out", str(tmp_path / "o1"))
     assert r.exit_code == 2 and "bonded stack" in r.output and "Traceback" not in r.output, r.output
@@ -292,3 +298,13 @@ def test_buckle_refuses_interfaces_and_bad_options(tmp_path):
     assert r.exit_code == 2 and "no loads" in r.output, r.output
     r = buckle(tmp_path, column_text(4), "--modes", "0")
     assert r.exit_code == 2, r.output
+    loose = column_text(4).replace('components = ["x", "y", "z"]', 'components = ["x", "z"]')  # free along y
+    r = buckle(tmp_path, loose, "--out", str(tmp_path / "o3"))
+    assert r.exit_code == 2 and "rigid-body motion" in r.output, r.output
+
+
+def test_superlu_gives_the_same_loads():
+    """Both linear-solver backends factorise K₀: the same buckling loads to 10⁻⁸."""
+    model = build(parse(column_text(4))).model
+    assert np.allclose(linear_buckling(model, 2, "superlu").load_factors, linear_buckling(model, 2).load_factors,
+                       rtol=1e-8)

@@ -29,7 +29,8 @@ def _mode_shape(m: meshmod.Mesh, imp, base: Path) -> np.ndarray:
         with np.load(path) as data:
             nodes, disp = data["nodes"], data["displacement"]
     except (OSError, ValueError, KeyError, zipfile.BadZipFile) as exc:
-        raise InputError(f"'{F}.folder': {path} cannot be read ({exc}); write it again with `layershell buckle`") from None
+        raise InputError(f"'{F}.folder': {path} cannot be read ({exc}); write it again with "
+                         "`layershell buckle`") from None
     if imp.mode > disp.shape[0]:
         raise InputError(f"'{F}.mode': mode {imp.mode} does not exist, {path} holds {disp.shape[0]} mode(s); give a "
                          f"mode from 1 to {disp.shape[0]}, or write more with `layershell buckle MODEL --modes "
