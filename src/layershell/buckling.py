@@ -133,7 +133,10 @@ def linear_buckling(model: Model, n_modes: int = 1, backend: str = "auto") -> Bu
                             "buckle; check the loads and supports")
     k = min(n - 1, max(2 * n_modes, n_modes + 4))  # a few more: the positive ones among the largest μ
     Minv = spla.LinearOperator((n, n), matvec=solve0, dtype=float)
-    mu, vec = spla.eigsh(-K1 / scale, k=k, M=K0, Minv=Minv, which="LA", tol=1e-12)
+    try:
+        mu, vec = spla.eigsh(-K1 / scale, k=k, M=K0, Minv=Minv, which="LA", tol=1e-12)
+    except (spla.ArpackNoConvergence, spla.ArpackError) as exc:
+        raise BucklingError(f"the eigensolver did not converge ({exc}); ask for fewer modes (--modes)") from None
     mu = mu * scale
     keep = np.flatnonzero(mu > 1e-12 * np.max(np.abs(mu)))
     if keep.size == 0:

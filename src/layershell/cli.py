@@ -481,6 +481,9 @@ def buckle(
     _guarded(f"buckling files of {model}", write_buckling, out_dir, res, info)
     for k, lam in enumerate(res.load_factors, start=1):
         out.print(f"  mode {k}: load factor {lam:.6g}", highlight=False)
+    if len(res.load_factors) < modes:
+        err.print(f"warning: {len(res.load_factors)} of the {modes} modes asked for have a positive load factor "
+                  "(the others would buckle under the reversed load)", soft_wrap=True, highlight=False)
     out.print(f"{len(res.load_factors)} buckling mode(s) of the bonded model, {res.problem.op.n_red} unknowns — "
               f"results in {out_dir}/ (buckling.json, buckling.csv, buckling_mode_*.vtu, buckling_modes.npz, "
               "buckling_modes.png)", soft_wrap=True, highlight=False)
