@@ -33,6 +33,9 @@ SECTIONS = [
     ("[materials.NAME] type = \"orthotropic\"", schema.OrthotropicMat,
      "Orthotropic material, nine constants in the material frame (axis 3 = shell normal)."),
     ("[[layers]]", schema.LayerDef, "Layers, from the reference face outward."),
+    ("[imperfection]", schema.ImperfectionDef,
+     "Optional: a geometric imperfection, moving the mesh nodes along the reference face's normal before the "
+     "analysis (a buckling mode of `layershell buckle`, or a formula)."),
     ("[[stacks]]", schema.StackDef,
      "Optional: which elements carry which layers (default: all layers everywhere). Every element carries exactly "
      "one stack: selections must not overlap, and one stack without `where` and `set` takes the remaining "

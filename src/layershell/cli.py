@@ -1,4 +1,4 @@
-"""Command line: ``layershell run | check | report | sweep | calibrate``. Bad input ends with one
+"""Command line: ``layershell run | check | buckle | report | sweep | calibrate``. Bad input ends with one
 paragraph and exit code 2.
 
 Exit codes: 0 success; 1 the solution failed (no convergence) or an internal error; 2 bad input
@@ -447,6 +447,46 @@ def _guarded(what: str, fn, *args, **kwargs):
             raise
         _fail(f"{what} stopped with an internal error ({type(exc).__name__}: {exc}); set LAYERSHELL_TRACEBACK=1 "
               "to see where, and report it with the model file", 1)
+
+
+@app.command()
+def buckle(
+    model: Path = typer.Argument(..., help="model file (TOML)"),
+    modes: int = typer.Option(3, "--modes", "-n", min=1, help="number of buckling modes"),
+    out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>_buckle)"),
+):
+    """Linear (eigenvalue) buckling of the bonded model under its loads at λ = 1: writes buckling.json,
+    buckling.csv, buckling_mode_<k>.vtu, buckling_modes.npz (for [imperfection]) and buckling_modes.png."""
+    spec = _load(model)
+    from .buckling import BucklingError, linear_buckling
+    from .buckling_output import write_buckling
+    from .constraints import ConstraintError
+    from .loads import LoadError
+
+    out_dir = _results_folder(out_dir, model, "_buckle")
+    from .io.build import InputError
+
+    def analyse():
+        try:
+            return linear_buckling(spec.model, modes, spec.newton.backend)
+        except BucklingError as exc:
+            raise InputError(f"{model}: {exc}") from None
+        except ConstraintError as exc:
+            raise InputError(f"{model}: 'supports': {exc}") from None
+        except LoadError as exc:
+            raise InputError(f"{model}: 'loads': {exc}") from None
+
+    res = _guarded(f"buckling analysis of {model}", analyse)
+    info = {"title": spec.source.model.title, "model_file": str(model), "units": spec.model.units}
+    _guarded(f"buckling files of {model}", write_buckling, out_dir, res, info)
+    for k, lam in enumerate(res.load_factors, start=1):
+        out.print(f"  mode {k}: load factor {lam:.6g}", highlight=False)
+    if len(res.load_factors) < modes:
+        err.print(f"warning: {len(res.load_factors)} of the {modes} modes asked for have a positive load factor "
+                  "(the others would buckle under the reversed load)", soft_wrap=True, highlight=False)
+    out.print(f"{len(res.load_factors)} buckling mode(s) of the bonded model, {res.problem.op.n_red} unknowns — "
+              f"results in {out_dir}/ (buckling.json, buckling.csv, buckling_mode_*.vtu, buckling_modes.npz, "
+              "buckling_modes.png)", soft_wrap=True, highlight=False)
 
 
 @app.command()

@@ -1128,6 +1128,10 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         if pr.component not in (*STRESS_COMPONENTS, "p1", "p2", "p3", "von_mises"):
             raise InputError(f"'profiles[{i}].component': '{pr.component}' is not a stress component; use one of "
                              f"{[*STRESS_COMPONENTS, 'p1', 'p2', 'p3', 'von_mises']}")
+    if mf.imperfection is not None:  # after every selection: supports, loads and probes find the perfect mesh
+        from .imperfection import imperfect_nodes
+
+        m.nodes = imperfect_nodes(m, mf.imperfection, base)
     spec = RunSpec(model, lf, newton, probes, mf.output, mf)
     spec.profiles = list(mf.profiles)
     from .lines import build_lines

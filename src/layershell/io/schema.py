@@ -776,6 +776,31 @@ class OutputDef(Strict):
         return sorted(v) if v is not None else v
 
 
+class ImperfectionDef(Strict):
+    mode: PositiveInt | None = Field(None, description=(
+        "buckling mode (1 = the lowest) from 'folder', written by `layershell buckle`: the nodes move along "
+        "the reference face's normal by the mode's normal displacement, scaled to a largest offset of "
+        "'amplitude'; instead of 'formula'"))
+    folder: str | None = Field(None, description=(
+        "with 'mode': the results folder of `layershell buckle` for this mesh (holding buckling_modes.npz), "
+        "relative to the model file"))
+    formula: str | None = Field(None, description=(
+        "instead of 'mode': the normal offset as a formula in x, y, z (length, multiplied by 'amplitude'), "
+        "e.g. 'sin(pi*x/100)'"))
+    amplitude: FiniteFloat = Field(description=(
+        "with 'mode': the largest normal offset of a node (length; the sign flips the mode); with 'formula': "
+        "the factor on it"))
+
+    @model_validator(mode="after")
+    def _one_shape(self):
+        if (self.mode is None) == (self.formula is None):
+            raise ValueError("'imperfection': give either 'mode' (with 'folder') or 'formula', not both nor neither")
+        if self.mode is not None and self.folder is None:
+            raise ValueError("'imperfection.folder': 'mode' needs the results folder of `layershell buckle` that "
+                             "holds the modes, e.g. folder = 'results/plate_buckle'")
+        return self
+
+
 class ModelFile(Strict):
     model: ModelSettings = ModelSettings()
     mesh: Mesh
@@ -792,6 +817,7 @@ class ModelFile(Strict):
     interfaces: list[InterfaceDef] = []
     delamination: DelaminationDef = DelaminationDef()
     output: OutputDef = OutputDef()
+    imperfection: ImperfectionDef | None = None
 
     @model_validator(mode="after")
     def _names(self):
