@@ -348,8 +348,8 @@ def layer_end_nodes(model: Model) -> np.ndarray:
     """Nodes shared by elements that carry different sets of layers (where a layer of a
     ``[[stacks]]`` region ends inside the mesh)."""
     E = model.mesh.elements
-    sig = {}
-    stack_id = np.array([sig.setdefault(tuple(sorted(model.stacks[s])), len(sig)) for s in range(len(model.stacks))])
+    layer_sets = {}  # one id per distinct set of layers (two stacks may hold the same layers)
+    stack_id = np.array([layer_sets.setdefault(tuple(sorted(st)), len(layer_sets)) for st in model.stacks])
     ids = np.repeat(stack_id[model.element_stack], 9)
     lo = np.full(model.mesh.n_nodes, np.iinfo(np.int64).max)
     hi = np.full(model.mesh.n_nodes, -1)
