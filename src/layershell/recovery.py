@@ -432,6 +432,10 @@ class Recovery:
     """Recovered transverse stresses of a model (geometry-dependent operators cached)."""
 
     def __init__(self, model: Model, dm: DofMap, n_gauss: int = 3, degree: int = 2, patch: str = "node"):
+        stacked = [ly.name for ly in model.layers if ly.plies]
+        if stacked:
+            raise ValueError(f"recovered transverse stresses are not available for the ply-stack layer(s) {stacked} "
+                             "(their stresses jump from ply to ply); use sampling = 'raw'")
         self.model, self.dm, self.n_gauss = model, dm, n_gauss
         self.inc = incidence(model)
         self.R = {}  # per layer: {reflection mask g: operator}, see mirrored_operators

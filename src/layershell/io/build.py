@@ -23,8 +23,8 @@ from pydantic import BaseModel, ValidationError
 from .. import mesh as meshmod
 from ..element.shape import EDGES
 from ..formula import FormulaError
-from ..material import MaterialError, Orthotropic
-from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry, Tie
+from ..material import MaterialError, Orthotropic, laminate_equivalent
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, Ply, SurfaceLoad, Symmetry, Tie
 from ..solver.newton import NewtonSettings
 from . import schema
 from .errors import XYZ, InputError  # defined apart: io/probes.py needs them without importing this module
@@ -870,6 +870,44 @@ def _check_slender(model: Model) -> None:
                          "mesh (e.g. mm against m, or the mesh file's 'scale')")
 
 
+def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray) -> Layer:
+    """The model's layer of ``ld`` (materials ``mats``, nodal thickness ``th``); a ply stack takes
+    its homogenised equivalent as the layer material (estimates only, :class:`Layer`)."""
+    direction = tuple(ld.direction) if ld.direction is not None else None
+    if ld.plies is None:
+        return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction)
+    total = sum(p.thickness for p in ld.plies)
+    plies = tuple(Ply(mats[p.material], p.angle, p.thickness / total) for p in ld.plies)
+    equivalent = laminate_equivalent([(p.material, p.angle, p.fraction) for p in plies],
+                                     name=f"plies of layer '{ld.name}'")
+    return Layer(ld.name, equivalent, ld.directors, th, ld.angle, direction, plies)
+
+
+def _check_ply_stack_sampling(mf: schema.ModelFile, model: Model) -> None:
+    """Recovered transverse stresses integrate each layer's stresses as one polynomial through its
+    thickness, which a ply stack's stresses (piecewise, one piece per ply) are not: refuse them
+    where a layer has plies."""
+    stacked = [ly.name for ly in model.layers if ly.plies]
+    if not stacked:
+        return
+    uses = [f"probes[{i}].sampling" for i, p in enumerate(mf.probes)
+            if p.quantity in ("stress", "traction") and p.sampling == "recovered"]
+    uses += [f"profiles[{i}].sampling" for i, p in enumerate(mf.profiles) if p.sampling == "recovered"]
+    uses += [f"lines[{i}].sampling" for i, ln in enumerate(mf.lines)
+             if ln.quantity != "displacement" and ln.sampling == "recovered"]
+    uses += [f"interfaces[{i}].stresses" for i, d in enumerate(mf.interfaces) if d.stresses == "recovered"]
+    if mf.output.vtu and mf.output.sampling == "recovered":
+        uses.append("output.sampling")
+    if uses:
+        raise InputError(f"'{uses[0]}': layer(s) {', '.join(repr(n) for n in stacked)} hold a ply stack, and "
+                         "recovered transverse stresses (the default) are not available for ply stacks: they "
+                         "integrate the equilibrium through each layer as one polynomial, which a stress that "
+                         "jumps from ply to ply is not. Set sampling = 'raw' there (stresses from the "
+                         "displacement derivatives, per ply)"
+                         + (f"; the same holds for {', '.join(repr(u) for u in uses[1:])}" if uses[1:] else "")
+                         + ", or model the plies as layers of their own")
+
+
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -888,7 +926,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     index = {n: i for i, n in enumerate(names)}
     layers = []
     for i, ld in enumerate(mf.layers):
-        th = _nodal_values(m, ld.thickness, f"layers[{i}].thickness", **m.node_fields)  # h_meridian: revolution
+        given = ld.thickness if ld.plies is None or ld.thickness is not None else sum(p.thickness for p in ld.plies)
+        th = _nodal_values(m, given, f"layers[{i}].thickness", **m.node_fields)  # h_meridian: revolution
         if not np.all((th > 0) & np.isfinite(th)):
             bad = np.flatnonzero(~((th > 0) & np.isfinite(th)))
             raise InputError(f"'layers[{i}].thickness': must be positive and finite at every node, but is "
@@ -903,8 +942,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              "computed in floating point; check the units of the thickness and of the mesh")
         if ld.direction is not None:
             _vec(ld.direction, f"layers[{i}].direction")
-        layers.append(Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle,
-                            tuple(ld.direction) if ld.direction is not None else None))
+        layers.append(_layer(ld, mats, th))
 
     def layer_idx(name, field):
         if name is None:
@@ -957,6 +995,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
     _check_slender(model)
+    _check_ply_stack_sampling(mf, model)
     first = stacks[0][0]
     if mf.mesh.surface == "middle":
         m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)
