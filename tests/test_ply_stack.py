@@ -210,3 +210,131 @@ def test_ply_stack_converges_with_mesh_and_thickness_points():
     print("w on 2, 4, 8, 16:", w, "changes", d)
     assert d[1] < 0.25 * d[0] and d[2] < 0.25 * d[1]
     assert abs(w[2] / w[3] - 1) < 5e-4
+
+
+# --------------------------------------------------------------------- model file and CLI
+MODEL = """
+[model]
+units = "N, mm"
+nonlinear = false
+
+[mesh]
+type = "rectangle"
+lx = 100.0
+ly = 20.0
+nx = 4
+ny = 1
+
+[materials.cfrp]
+type = "orthotropic"
+E1 = 140000.0
+E2 = 10000.0
+E3 = 10000.0
+G12 = 5000.0
+G23 = 3500.0
+G31 = 5000.0
+nu12 = 0.3
+nu23 = 0.45
+nu13 = 0.3
+
+[[layers]]
+name = "laminate"
+{layer}
+directors = 2
+
+[[supports]]
+type = "fix"
+where = "near(x, 0)"
+layer = "all"
+directors = "all"
+
+[[loads]]
+type = "surface"
+face = "top"
+direction = [0, 0, -1]
+magnitude = 0.01
+
+[steps]
+n = 1
+
+[output]
+sampling = "raw"
+
+[[probes]]
+name = "w_tip"
+quantity = "displacement"
+point = [100, 10, 0]
+component = "z"
+
+[[probes]]
+name = "s11_top"
+quantity = "stress"
+point = [25, 10, 0]
+theta3 = 1.0
+component = "11"
+{sampling}
+"""
+PLIES = ('plies = [{material = "cfrp", angle = 0, thickness = 0.25}, {material = "cfrp", angle = 90, '
+         'thickness = 0.5}, {material = "cfrp", angle = 0, thickness = 0.25}]')
+
+
+def _cli(tmp_path, layer, sampling='sampling = "raw"', command="check", extra=()):
+    f = tmp_path / "model.toml"
+    f.write_text(MODEL.format(layer=layer, sampling=sampling), encoding="utf-8")
+    r = subprocess.run([sys.executable, "-m", "layershell.cli", command, str(f), *extra], capture_output=True,
+                       text=True, cwd=tmp_path, timeout=300)
+    return r
+
+
+BAD = {
+    "thicknesses do not sum": (PLIES + "\nthickness = 1.1", ["layers[0]", "0.25 + 0.5 + 0.25 = 1", "1.1",
+                                                              "leave out the layer's 'thickness'"]),
+    "angle not a number": (PLIES.replace("angle = 90", 'angle = "90deg"'),
+                           ["layers[0].plies[1].angle", "must be a number of degrees", "'90deg'"]),
+    "unknown ply material": (PLIES.replace('"cfrp", angle = 90', '"crfp", angle = 90'),
+                             ["layers[0].plies[1].material", "unknown material 'crfp'", "['cfrp']"]),
+    "plies and material": ('material = "cfrp"\n' + PLIES, ["layers[0]", "either one material or a ply stack",
+                                                           "leave out the layer's 'material'"]),
+    "formula thickness": (PLIES + '\nthickness = "1 + 0*x"', ["layers[0]", "cannot be the formula",
+                                                              "thickness = 1"]),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD))
+def test_bad_ply_input_is_one_paragraph_with_exit_2(tmp_path, case):
+    layer, expected = BAD[case]
+    r = _cli(tmp_path, layer)
+    msg = r.stderr.strip()
+    assert r.returncode == 2, r.stderr + r.stdout
+    assert "Traceback" not in r.stderr and msg.startswith("error:") and len(msg.splitlines()) == 1, msg
+    for text in expected:
+        assert text in msg, (text, msg)
+
+
+def test_recovered_sampling_of_a_ply_stack_is_refused(tmp_path):
+    """The default 'recovered' sampling of a stress probe on a ply-stack layer: exit 2 naming
+    the probe's field and the fix sampling = 'raw'."""
+    r = _cli(tmp_path, PLIES, sampling="")
+    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
+    assert "'probes[1].sampling'" in r.stderr and "sampling = 'raw'" in r.stderr and "'laminate'" in r.stderr
+
+
+def test_model_file_ply_stack_runs_and_matches_the_python_layer(tmp_path):
+    """A ply-stack layer from the model file (thickness from the plies, 0.25 + 0.5 + 0.25): the
+    model's layer has the three plies with fractions 1/4, 1/2, 1/4, thickness 1 at every node, and
+    its stiffness equals the plain layer's when all plies are 0° (to round-off); 'run' of the
+    cantilever gives the tip deflection of the same layer given ply by ply with the thickness."""
+    from layershell.io.build import build, parse
+
+    spec = build(parse(MODEL.format(layer=PLIES, sampling='sampling = "raw"')))
+    ly = spec.model.layers[0]
+    assert [p.fraction for p in ly.plies] == [0.25, 0.5, 0.25] and [p.angle for p in ly.plies] == [0, 90, 0]
+    assert np.all(ly.thickness == 1.0)
+    r1 = _cli(tmp_path, PLIES, command="run", extra=("--out", "a", "--no-vtu"))
+    r2 = _cli(tmp_path, PLIES + "\nthickness = 1.0", command="run", extra=("--out", "b", "--no-vtu"))
+    assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
+    import json
+
+    w1 = json.loads((tmp_path / "a" / "summary.json").read_text())["probes"]["w_tip"]
+    w2 = json.loads((tmp_path / "b" / "summary.json").read_text())["probes"]["w_tip"]
+    assert w1 == w2 and w1 < 0
