@@ -197,19 +197,43 @@ def test_pagano_cross_ply_one_layer_against_three_layers_and_exact(s):
         assert np.abs(e1).max() < 0.005
 
 
+@pytest.mark.parametrize("s, tol", [(10, 0.045), (20, 0.02)])
+def test_recovered_transverse_stresses_of_a_ply_stack(s, tol):
+    """Recovery integrates the equilibrium ply by ply (levels in each ply, each ply's stress a
+    polynomial): the one-layer [0/90/0] plate's recovered τxz at the edge x = 0 and τyz at y = 0,
+    at both ply interfaces and mid-thickness, within 4.5 % (a/h = 10; measured +2.3 %, -3.9 %) and
+    2 % (a/h = 20; +0.6 %, -1.6 %) of the exact ones, the error of its in-plane stresses (above);
+    σzz at (a/4, a/4) within 0.5 % of q0. Three layers: within 0.1 % (tests/test_recovery.py)."""
+    from test_recovery import _at
+
+    from layershell.recovery import Recovery
+
+    m, pb, u, ex = _pagano(s)
+    a = float(s)
+    rec = Recovery(m, pb.dm)
+    z = np.array([1 / 3, 0.5, 2 / 3])
+    lay = np.zeros(z.size, int)
+    for comp, point, i in (("txz", [0, a / 2, 0], 0), ("tyz", [a / 2, 0, 0], 1)):
+        el, xi, eta = _at(m, point, z.size)
+        err = rec.points(u, el, xi, eta, z, lay).S[:, i, 2] / ex.fields(point[0], point[1], z)[comp] - 1
+        assert np.abs(err).max() < tol, (comp, err)
+    el, xi, eta = _at(m, [a / 4, a / 4, 0], z.size)
+    s33 = rec.points(u, el, xi, eta, z, lay).S[:, 2, 2]
+    assert np.abs(s33 - ex.fields(a / 4, a / 4, z)["szz"]).max() < 0.005
+
+
 def test_ply_stack_converges_with_mesh_and_thickness_points():
     """One [0/90/0] layer, a/h = 10, centre deflection: 4, 5, 6 thickness points per ply give the
     same w to 1e-9 (each ply's polynomial integrand is integrated exactly by d + 1 = 4 points),
     and on 2 × 2, 4 × 4, 8 × 8 quarter meshes w converges: each refinement changes it by less than
-    a quarter of the previous change, the finest within 0.05 % of the 16 × 16 mesh."""
+    a quarter of the previous change (measured 0.0499, 0.0040), the last by less than 1e-4 of w."""
     s = 10
     w_nt = [_centre_values(*_pagano(s, n=4, nt=nt)[:3], s, True)[0] for nt in (4, 5, 6)]
     assert np.ptp(w_nt) < 1e-9 * abs(w_nt[0])
-    w = [_centre_values(*_pagano(s, n=n)[:3], s, True)[0] for n in (2, 4, 8, 16)]
+    w = [_centre_values(*_pagano(s, n=n)[:3], s, True)[0] for n in (2, 4, 8)]
     d = np.abs(np.diff(w))
-    print("w on 2, 4, 8, 16:", w, "changes", d)
-    assert d[1] < 0.25 * d[0] and d[2] < 0.25 * d[1]
-    assert abs(w[2] / w[3] - 1) < 5e-4
+    assert d[1] < 0.25 * d[0]
+    assert d[1] < 1e-4 * abs(w[2])
 
 
 # --------------------------------------------------------------------- model file and CLI
@@ -257,9 +281,6 @@ magnitude = 0.01
 [steps]
 n = 1
 
-[output]
-sampling = "raw"
-
 [[probes]]
 name = "w_tip"
 quantity = "displacement"
@@ -272,31 +293,38 @@ quantity = "stress"
 point = [25, 10, 0]
 theta3 = 1.0
 component = "11"
-{sampling}
+
+[[profiles]]
+name = "s13"
+point = [50, 10, 0]
+component = "13"
 """
 PLIES = ('plies = [{material = "cfrp", angle = 0, thickness = 0.25}, {material = "cfrp", angle = 90, '
          'thickness = 0.5}, {material = "cfrp", angle = 0, thickness = 0.25}]')
 
 
-def _cli(tmp_path, layer, sampling='sampling = "raw"', command="check", extra=()):
+def _cli(tmp_path, layer, command="check", extra=()):
     f = tmp_path / "model.toml"
-    f.write_text(MODEL.format(layer=layer, sampling=sampling), encoding="utf-8")
+    f.write_text(MODEL.format(layer=layer), encoding="utf-8")
     r = subprocess.run([sys.executable, "-m", "layershell.cli", command, str(f), *extra], capture_output=True,
                        text=True, cwd=tmp_path, timeout=300)
     return r
 
 
 BAD = {
-    "thicknesses do not sum": (PLIES + "\nthickness = 1.1", ["layers[0]", "0.25 + 0.5 + 0.25 = 1", "1.1",
+    "thicknesses do not sum": (PLIES + "\nthickness = 1.1", ["'layers[0].thickness'", "0.25 + 0.5 + 0.25 = 1", "1.1",
                                                               "leave out the layer's 'thickness'"]),
     "angle not a number": (PLIES.replace("angle = 90", 'angle = "90deg"'),
                            ["layers[0].plies[1].angle", "must be a number of degrees", "'90deg'"]),
     "unknown ply material": (PLIES.replace('"cfrp", angle = 90', '"crfp", angle = 90'),
                              ["layers[0].plies[1].material", "unknown material 'crfp'", "['cfrp']"]),
-    "plies and material": ('material = "cfrp"\n' + PLIES, ["layers[0]", "either one material or a ply stack",
+    "plies and material": ('material = "cfrp"\n' + PLIES, ["'layers[0].material'", "either one material or a ply stack",
                                                            "leave out the layer's 'material'"]),
-    "formula thickness": (PLIES + '\nthickness = "1 + 0*x"', ["layers[0]", "cannot be the formula",
+    "formula thickness": (PLIES + '\nthickness = "1 + 0*x"', ["'layers[0].thickness'", "cannot be the formula",
                                                               "thickness = 1"]),
+    "neither material nor plies": ("thickness = 1.0", ["'layers[0].material'", "required key is missing",
+                                                       "plies = ["]),
+    "thickness within 1e-9": (PLIES + "\nthickness = 1.0000001", ["'layers[0].thickness'", "1e-9 relative"]),
 }
 
 
@@ -311,30 +339,26 @@ def test_bad_ply_input_is_one_paragraph_with_exit_2(tmp_path, case):
         assert text in msg, (text, msg)
 
 
-def test_recovered_sampling_of_a_ply_stack_is_refused(tmp_path):
-    """The default 'recovered' sampling of a stress probe on a ply-stack layer: exit 2 naming
-    the probe's field and the fix sampling = 'raw'."""
-    r = _cli(tmp_path, PLIES, sampling="")
-    assert r.returncode == 2 and "Traceback" not in r.stderr, r.stderr
-    assert "'probes[1].sampling'" in r.stderr and "sampling = 'raw'" in r.stderr and "'laminate'" in r.stderr
-
-
-def test_model_file_ply_stack_runs_and_matches_the_python_layer(tmp_path):
-    """A ply-stack layer from the model file (thickness from the plies, 0.25 + 0.5 + 0.25): the
-    model's layer has the three plies with fractions 1/4, 1/2, 1/4, thickness 1 at every node, and
-    its stiffness equals the plain layer's when all plies are 0° (to round-off); 'run' of the
-    cantilever gives the tip deflection of the same layer given ply by ply with the thickness."""
+def test_model_file_ply_stack_runs_against_laminated_beam_theory(tmp_path):
+    """A ply-stack layer from the model file, its thickness from the plies (0.25 + 0.5 + 0.25; a
+    thickness within 1e-9 of the sum is accepted): the model's layer holds the three plies with
+    fractions 1/4, 1/2, 1/4. 'run' of the cantilever strip (L = 100, clamped, q = 0.01 on top,
+    default recovered sampling): tip deflection within 1 % of laminated beam theory
+    q L⁴ (D⁻¹)₁₁ / 8 with D from CLT (above), L/h = 100 so shear adds < 1 %; a stress profile is
+    written."""
     from layershell.io.build import build, parse
 
-    spec = build(parse(MODEL.format(layer=PLIES, sampling='sampling = "raw"')))
+    spec = build(parse(MODEL.format(layer=PLIES)))
     ly = spec.model.layers[0]
     assert [p.fraction for p in ly.plies] == [0.25, 0.5, 0.25] and [p.angle for p in ly.plies] == [0, 90, 0]
     assert np.all(ly.thickness == 1.0)
-    r1 = _cli(tmp_path, PLIES, command="run", extra=("--out", "a", "--no-vtu"))
-    r2 = _cli(tmp_path, PLIES + "\nthickness = 1.0", command="run", extra=("--out", "b", "--no-vtu"))
-    assert r1.returncode == 0 and r2.returncode == 0, r1.stderr + r2.stderr
+    build(parse(MODEL.format(layer=PLIES + "\nthickness = 1.0000000005")))
+    r = _cli(tmp_path, PLIES, command="run", extra=("--out", "out", "--no-vtu"))
+    assert r.returncode == 0, r.stderr
     import json
 
-    w1 = json.loads((tmp_path / "a" / "summary.json").read_text())["probes"]["w_tip"]
-    w2 = json.loads((tmp_path / "b" / "summary.json").read_text())["probes"]["w_tip"]
-    assert w1 == w2 and w1 < 0
+    w = json.loads((tmp_path / "out" / "summary.json").read_text())["probes"]["w_tip"]
+    _, _, D = clt_abd([0, 90, 0], [0.25, 0.5, 0.25])
+    beam = 0.01 * 100.0**4 / 8 * np.linalg.inv(D)[0, 0]
+    assert abs(-w / beam - 1) < 0.01, (w, beam)
+    assert (tmp_path / "out" / "profile_s13.csv").is_file()

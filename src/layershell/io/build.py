@@ -883,31 +883,6 @@ def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray) -> Layer:
     return Layer(ld.name, equivalent, ld.directors, th, ld.angle, direction, plies)
 
 
-def _check_ply_stack_sampling(mf: schema.ModelFile, model: Model) -> None:
-    """Recovered transverse stresses integrate each layer's stresses as one polynomial through its
-    thickness, which a ply stack's stresses (piecewise, one piece per ply) are not: refuse them
-    where a layer has plies."""
-    stacked = [ly.name for ly in model.layers if ly.plies]
-    if not stacked:
-        return
-    uses = [f"probes[{i}].sampling" for i, p in enumerate(mf.probes)
-            if p.quantity in ("stress", "traction") and p.sampling == "recovered"]
-    uses += [f"profiles[{i}].sampling" for i, p in enumerate(mf.profiles) if p.sampling == "recovered"]
-    uses += [f"lines[{i}].sampling" for i, ln in enumerate(mf.lines)
-             if ln.quantity != "displacement" and ln.sampling == "recovered"]
-    uses += [f"interfaces[{i}].stresses" for i, d in enumerate(mf.interfaces) if d.stresses == "recovered"]
-    if mf.output.vtu and mf.output.sampling == "recovered":
-        uses.append("output.sampling")
-    if uses:
-        raise InputError(f"'{uses[0]}': layer(s) {', '.join(repr(n) for n in stacked)} hold a ply stack, and "
-                         "recovered transverse stresses (the default) are not available for ply stacks: they "
-                         "integrate the equilibrium through each layer as one polynomial, which a stress that "
-                         "jumps from ply to ply is not. Set sampling = 'raw' there (stresses from the "
-                         "displacement derivatives, per ply)"
-                         + (f"; the same holds for {', '.join(repr(u) for u in uses[1:])}" if uses[1:] else "")
-                         + ", or model the plies as layers of their own")
-
-
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -995,7 +970,6 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
     _check_slender(model)
-    _check_ply_stack_sampling(mf, model)
     first = stacks[0][0]
     if mf.mesh.surface == "middle":
         m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)

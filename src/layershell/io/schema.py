@@ -298,31 +298,33 @@ class LayerDef(Strict):
                              "number or a formula in x, y, z")
         return v
 
-    @model_validator(mode="after")
-    def _material_or_plies(self):
-        if self.plies is None:
-            if self.material is None:
-                raise ValueError("required key is missing; give the layer a 'material' (a [materials.NAME] table) "
-                                 "or a ply stack 'plies = [{material = ..., angle = ..., thickness = ...}, ...]'")
-            if self.thickness is None:
-                raise ValueError("the layer's 'thickness' is missing; add 'thickness = ...' (a number or a formula in "
-                                 "x, y, z)")
-            return self
-        if self.material is not None:
-            raise ValueError(f"a layer has either one material or a ply stack, but this one has "
-                             f"material = '{self.material}' and 'plies'; each ply names its own material, so leave "
-                             "out the layer's 'material' (or give the layer one material and no 'plies')")
-        total = sum(p.thickness for p in self.plies)
-        if isinstance(self.thickness, str):
-            raise ValueError(f"a layer with 'plies' is {total:.12g} thick (the sum of its plies), so its "
-                             f"thickness cannot be the formula '{self.thickness}'; leave 'thickness' out or give "
-                             f"thickness = {total:.12g}")
-        if self.thickness is not None and abs(self.thickness - total) > 1e-9 * self.thickness:
-            listed = " + ".join(f"{p.thickness:g}" for p in self.plies)
-            raise ValueError(f"the plies are {listed} = {total:.12g} thick together, but the layer "
-                             f"thickness is {self.thickness:.12g} (they must agree to 1e-9 relative); fix the ply "
-                             "thicknesses, or leave out the layer's 'thickness' so that it follows from the plies")
-        return self
+
+def _check_layer_material(ly: LayerDef, i: int) -> None:
+    """One material or a ply stack, and a layer thickness that the plies agree with."""
+    at = f"layers[{i}]"
+    if ly.plies is None:
+        if ly.material is None:
+            raise ValueError(f"'{at}.material': required key is missing; give the layer a 'material' (a "
+                             "[materials.NAME] table) or a ply stack 'plies = [{material = ..., angle = ..., "
+                             "thickness = ...}, ...]'")
+        if ly.thickness is None:
+            raise ValueError(f"'{at}.thickness': required key is missing; add 'thickness = ...' (a number or a "
+                             "formula in x, y, z) to the layer")
+        return
+    if ly.material is not None:
+        raise ValueError(f"'{at}.material': a layer has either one material or a ply stack, but this one has "
+                         f"material = '{ly.material}' and 'plies'; each ply names its own material, so leave out "
+                         "the layer's 'material' (or give the layer one material and no 'plies')")
+    total = sum(p.thickness for p in ly.plies)
+    if isinstance(ly.thickness, str):
+        raise ValueError(f"'{at}.thickness': a layer with 'plies' is {total:.12g} thick (the sum of its plies), so "
+                         f"its thickness cannot be the formula '{ly.thickness}'; leave 'thickness' out or give "
+                         f"thickness = {total:.12g}")
+    if ly.thickness is not None and abs(ly.thickness - total) > 1e-9 * ly.thickness:
+        listed = " + ".join(f"{p.thickness:g}" for p in ly.plies)
+        raise ValueError(f"'{at}.thickness': the plies are {listed} = {total:.12g} thick together, but the layer "
+                         f"thickness is {ly.thickness:.12g} (they must agree to 1e-9 relative); fix the ply "
+                         "thicknesses, or leave out the layer's 'thickness' so that it follows from the plies")
 
 
 class StackDef(Strict):
@@ -847,6 +849,7 @@ class ModelFile(Strict):
             raise ValueError(f"'layers': layer names must be unique, but {sorted(dup)} appear more than once; "
                              "rename the layers")
         for i, ly in enumerate(self.layers):
+            _check_layer_material(ly, i)
             used = [(f"layers[{i}].material", ly.material)] if ly.plies is None else [
                 (f"layers[{i}].plies[{j}].material", p.material) for j, p in enumerate(ly.plies)]
             for at, mat in used:
