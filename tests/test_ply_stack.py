@@ -362,3 +362,35 @@ def test_model_file_ply_stack_runs_against_laminated_beam_theory(tmp_path):
     beam = 0.01 * 100.0**4 / 8 * np.linalg.inv(D)[0, 0]
     assert abs(-w / beam - 1) < 0.01, (w, beam)
     assert (tmp_path / "out" / "profile_s13.csv").is_file()
+
+
+def test_solid_vtu_has_one_lattice_per_ply_with_its_material():
+    """The ParaView solid of a three-ply layer holds 8 hexahedra per element and ply, and at the
+    lattice points of each ply the stress of that ply: in material axes σ11 at the middle of the
+    90° ply (the centre of the plate) equals the global σyy there, and across the interface
+    between the 0° and the 90° ply the global σxx jumps by the ratio of the plies' stiffness
+    (more than 5x), the same as evaluate_points on either side."""
+    from test_recovery import _at
+
+    from layershell.export import solid_mesh
+    from layershell.results import evaluate_points
+
+    s = 10
+    m, pb, u, _ = _pagano(s, n=4)
+    mat = solid_mesh(m, pb.dm, u, sampling="raw", frame="material")
+    glo = solid_mesh(m, pb.dm, u, sampling="raw", frame="global")
+    ne = m.mesh.n_elements
+    assert mat.cells[0].data.shape == (8 * 3 * ne, 8)
+    X = mat.points
+    centre = np.isclose(X[:, 0], s / 2) & np.isclose(X[:, 1], s / 2)
+    mid90 = centre & np.isclose(X[:, 2], 0.5)
+    assert mid90.any()
+    # stress components in order 11, 22, 33, 23, 13, 12
+    assert np.allclose(mat.point_data["pk2"][mid90, 0], glo.point_data["pk2"][mid90, 1], rtol=1e-10)
+    below = centre & np.isclose(X[:, 2], 1 / 3, atol=1e-6) & (X[:, 2] < 1 / 3)
+    above = centre & np.isclose(X[:, 2], 1 / 3, atol=1e-6) & (X[:, 2] > 1 / 3)
+    sx_below, sx_above = glo.point_data["pk2"][below, 0].mean(), glo.point_data["pk2"][above, 0].mean()
+    assert abs(sx_below) > 5 * abs(sx_above)
+    c = _at(m, [s / 2, s / 2, 0], 2)
+    ref = evaluate_points(m, pb.dm, u, *c, [1 / 3 - 1e-9, 1 / 3 + 1e-9], [0, 0]).S[:, 0, 0]
+    assert np.allclose([sx_below, sx_above], ref, rtol=1e-6)
