@@ -70,7 +70,8 @@ class ModelSettings(Strict):
         "resultants force/length, areas length²); nothing is converted"))
     nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
     thickness_points: PositiveInt = Field(
-        3, le=10, description="Gauss points through each layer (at least d are used: d = 4 needs 4)")
+        3, le=10, description="Gauss points through each layer, or through each ply of a layer "
+        "with 'plies' (at least d are used: d = 4 needs 4)")
     element: Literal["mitc", "full"] = Field(
         "mitc", description="shell element: 'mitc' = assumed-strain MITC9 (membrane and transverse shear "
                             "strains tied, no locking in thin shells; at least d + 1 thickness points), "
