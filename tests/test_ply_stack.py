@@ -394,3 +394,26 @@ def test_solid_vtu_has_one_lattice_per_ply_with_its_material():
     c = _at(m, [s / 2, s / 2, 0], 2)
     ref = evaluate_points(m, pb.dm, u, *c, [1 / 3 - 1e-9, 1 / 3 + 1e-9], [0, 0]).S[:, 0, 0]
     assert np.allclose([sx_below, sx_above], ref, rtol=1e-6)
+
+
+def test_homogenised_equivalent_of_a_stack():
+    """The stand-in material of a ply stack (penalties, process zones, gravity): in-plane constants
+    from CLT's A/h (E1 = 1/a11, E2 = 1/a22, G12 = 1/a66, ν12 = -a12/a11 with a = (A/h)⁻¹), the
+    quasi-isotropic stack in-plane isotropic (E1 = E2, G12 = E1/(2(1 + ν12))), E3 and G13 of the [0/90]s stack in series,
+    density the thickness average."""
+    from layershell.material import laminate_equivalent
+
+    for angles in ([0, 90, 90, 0], [0, 45, -45, 90, 90, -45, 45, 0]):
+        t = [0.125] * len(angles)
+        A, _, _ = clt_abd(angles, t)
+        a = np.linalg.inv(A / sum(t))
+        eq = laminate_equivalent([(CFRP_MAT, ang, 1.0) for ang in angles])
+        assert np.allclose([eq.E1, eq.E2, eq.G12, eq.nu12], [1 / a[0, 0], 1 / a[1, 1], 1 / a[2, 2], -a[0, 1] / a[0, 0]],
+                           rtol=1e-10)
+        eq.check()
+    assert np.isclose(eq.E1, eq.E2, rtol=1e-12) and np.isclose(eq.G12, eq.E1 / (2 * (1 + eq.nu12)), rtol=1e-12)
+    soft = Orthotropic.isotropic(1000.0, 0.3, density=2.0)
+    stiff = Orthotropic.isotropic(3000.0, 0.3, density=1.0)
+    eq = laminate_equivalent([(soft, 0.0, 0.25), (stiff, 90.0, 0.75)])
+    assert np.isclose(eq.E3, 1 / (0.25 / 1000 + 0.75 / 3000))
+    assert np.isclose(eq.G31, 1 / (0.25 / soft.G31 + 0.75 / stiff.G31)) and np.isclose(eq.density, 1.25)
