@@ -417,3 +417,13 @@ def test_homogenised_equivalent_of_a_stack():
     eq = laminate_equivalent([(soft, 0.0, 0.25), (stiff, 90.0, 0.75)])
     assert np.isclose(eq.E3, 1 / (0.25 / 1000 + 0.75 / 3000))
     assert np.isclose(eq.G31, 1 / (0.25 / soft.G31 + 0.75 / stiff.G31)) and np.isclose(eq.density, 1.25)
+
+
+def test_restart_hash_sees_the_plies():
+    """A restart file belongs to one model: a changed ply angle changes the model hash."""
+    from layershell.checkpoint import model_hash
+    from layershell.io.build import build, parse
+
+    h0 = model_hash(build(parse(MODEL.format(layer=PLIES))))
+    h1 = model_hash(build(parse(MODEL.format(layer=PLIES.replace("angle = 90", "angle = 80")))))
+    assert h0 != h1
