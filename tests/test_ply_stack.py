@@ -344,8 +344,8 @@ def test_model_file_ply_stack_runs_against_laminated_beam_theory(tmp_path):
     thickness within 1e-9 of the sum is accepted): the model's layer holds the three plies with
     fractions 1/4, 1/2, 1/4. 'run' of the cantilever strip (L = 100, clamped, q = 0.01 on top,
     default recovered sampling): tip deflection within 1 % of laminated beam theory
-    q L⁴ (D⁻¹)₁₁ / 8 with D from CLT (above), L/h = 100 so shear adds < 1 %; a stress profile is
-    written."""
+    q L⁴ (D⁻¹)₁₁ / 8 with D from CLT (above), L/h = 100 so shear adds < 1 %; the σ13 profile has
+    21 points in each ply and both sides of each ply boundary, each in its ply's material axes."""
     from layershell.io.build import build, parse
 
     spec = build(parse(MODEL.format(layer=PLIES)))
@@ -361,7 +361,11 @@ def test_model_file_ply_stack_runs_against_laminated_beam_theory(tmp_path):
     _, _, D = clt_abd([0, 90, 0], [0.25, 0.5, 0.25])
     beam = 0.01 * 100.0**4 / 8 * np.linalg.inv(D)[0, 0]
     assert abs(-w / beam - 1) < 0.01, (w, beam)
-    assert (tmp_path / "out" / "profile_s13.csv").is_file()
+    prof = np.genfromtxt(tmp_path / "out" / "profile_s13.csv", delimiter=",", skip_header=1)
+    assert prof.shape == (3 * 21, 2)  # points_per_layer in each ply
+    at = np.flatnonzero(np.abs(prof[:, 0] - 0.25) < 1e-6)  # both sides of the 0/90 boundary
+    lower, upper = prof[at, 1]
+    assert abs(lower) > 0.1 and abs(upper) < 1e-6 * abs(lower)  # σ13 in the 90° ply's axes is τyz = 0
 
 
 def test_solid_vtu_has_one_lattice_per_ply_with_its_material():

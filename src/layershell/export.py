@@ -137,18 +137,10 @@ def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
 
 def _ply_lattices(ly) -> list[np.ndarray]:
     """Layer fractions Θ_L³ / H_L (27,) of the lattice points of each ply of layer ``ly``: its
-    bottom, middle and top, the faces on inner ply boundaries moved 1e-9 of the ply into it (so
-    that they take the ply's own material, not the neighbour's)."""
-    from .recovery import ply_segments
+    bottom, middle and top (:func:`~.element.quadrature.ply_samples`)."""
+    from .element.quadrature import ply_samples
 
-    segs = ply_segments([f for _, _, f in ly.ply_table()])
-    out = []
-    for j, (lo, fr) in enumerate(segs):
-        m = 0.5 * _LAT_M.astype(float)
-        m = np.where(m == 0.0, 1e-9 if j > 0 else 0.0, m)
-        m = np.where(m == 1.0, 1.0 - 1e-9 if j < len(segs) - 1 else 1.0, m)
-        out.append(lo + fr * m)
-    return out
+    return [row[_LAT_M] for row in ply_samples([f for _, _, f in ly.ply_table()], 3)]
 
 
 def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray, sampling: str = "recovered", frame: str = "material",

@@ -51,3 +51,16 @@ def ply_of(fractions, s: np.ndarray) -> np.ndarray:
     f = np.asarray(fractions, float)
     inner = np.cumsum(f)[:-1] / f.sum()
     return np.searchsorted(inner, np.asarray(s, float), side="left")
+
+
+def ply_samples(fractions, n: int) -> np.ndarray:
+    """Layer fractions Θ_L³ / H_L of ``n`` evenly spaced samples in each ply, ``(plies, n)``, from
+    the ply's bottom to its top; ends on an inner ply boundary moved 1e-9 of the ply into it, so
+    that each sample takes its own ply's material (:func:`ply_of`). One ply: linspace(0, 1, n)."""
+    f = np.asarray(fractions, float)
+    f = f / f.sum()
+    lo = np.concatenate([[0.0], np.cumsum(f)[:-1]])
+    m = np.tile(np.linspace(0.0, 1.0, n), (f.size, 1))
+    m[1:, 0] = 1e-9
+    m[:-1, -1] = 1.0 - 1e-9
+    return lo[:, None] + f[:, None] * m

@@ -666,7 +666,8 @@ class ProfileDef(Strict):
         "through the thickness, or 'raw' values from the displacement derivatives (as [[probes]] sampling)")
     frame: Literal["material", "global"] = Field(
         "material", description="components in the layers' material axes (default) or the global x, y, z axes")
-    points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer")
+    points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer (through each ply of a "
+                                  "layer with 'plies')")
 
 
 class LineDef(Strict):
