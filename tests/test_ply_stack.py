@@ -431,3 +431,25 @@ def test_restart_hash_sees_the_plies():
     h0 = model_hash(build(parse(MODEL.format(layer=PLIES))))
     h1 = model_hash(build(parse(MODEL.format(layer=PLIES.replace("angle = 90", "angle = 80")))))
     assert h0 != h1
+
+
+@pytest.mark.parametrize("element", ["mitc", "full"])
+def test_nonlinear_tangent_of_a_ply_stack_matches_finite_differences(element):
+    """Green-Lagrange kinematics, [0/45/90] in one layer, d = 2, a distorted curved element: the
+    tangent equals central differences of the internal force (step 1e-6) to 1e-6 of its norm."""
+    rng = np.random.default_rng(3)
+    X, Hb, Hn = _unit_square(0.2)
+    X = X + rng.normal(scale=0.03, size=X.shape) * np.array([1.0, 1.0, 2.0])
+    plies = [(CFRP_MAT, 0.0, 0.3), (CFRP_MAT, 45.0, 0.3), (CFRP_MAT, 90.0, 0.4)]
+    blk = layer_block(X, Hb, Hn, 2, None, 0.0, n_thickness=3, element=element, plies=plies)
+    U = rng.normal(scale=0.02, size=(1, 27, 3))
+    f, K = layer_response(blk, U, nonlinear=True)
+    h = 1e-6
+    Kfd = np.empty_like(K[0])
+    for j in range(81):
+        dU = np.zeros(81)
+        dU[j] = h
+        fp, _ = layer_response(blk, U + dU.reshape(1, 27, 3), nonlinear=True, tangent=False)
+        fm, _ = layer_response(blk, U - dU.reshape(1, 27, 3), nonlinear=True, tangent=False)
+        Kfd[:, j] = (fp[0] - fm[0]) / (2 * h)
+    assert np.abs(Kfd - K[0]).max() < 1e-6 * np.abs(K[0]).max()

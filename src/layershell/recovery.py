@@ -8,7 +8,8 @@ equilibrium equations integrated through the thickness (e.g. Noor & Burton 1989;
 Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recovery
 (Zienkiewicz & Zhu 1992):
 
-1. σ at 3 × 3 Gauss points of every element at d_L + 1 Gauss levels Θ_L³ of each layer L;
+1. σ at 3 × 3 Gauss points of every element at d_L + 1 Gauss levels Θ_L³ of each layer L (of
+   each ply of a ply-stack layer, whose stress is one polynomial per ply);
    patch recovery per node (least-squares complete quadratic in the tangent plane over the
    elements at the node, :func:`spr_operator`) gives nodal values of the tensor in Cartesian
    components at each level.
@@ -21,7 +22,7 @@ Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recov
    interface shear of the thick plate of benchmarks/vs_solid.py on 8/16/32 elements, against
    0.20/0.13/0.10 % now.)
 3. ∂σ_α3/∂Θ³ = -D_α is integrated exactly (the levels carry the degree-d_L polynomial of each
-   layer) from the bottom face, where σ·(-A_3) equals the applied traction. σ33 follows from
+   layer, or ply) from the bottom face, where σ·(-A_3) equals the applied traction. σ33 follows from
    the shell equilibrium ∂(μ σ33)/∂Θ³ = μ ∫ ∂D_β/∂s_β - tr(B adj(I - Θ³B) σ_in) (shifter μ,
    curvature B: the hoop term of curved shells), by Gauss rules per layer; ∂D_β/∂s_β comes from
    the nodal D of step 2 (whose patch fits use mirror images at symmetry planes,
@@ -542,7 +543,7 @@ class Recovery:
         shell equilibrium ∂(μ σ33)/∂z = μ ∫_0^z ∂D_β/∂s_β - tr(B adj(I - zB) σ_in) with the
         shifter μ = det(I - zB) and curvature B (MODEL.md §2, (2.12)), so that the hoop-stress
         term of curved shells (∂(r σ_r)/∂r = σ_φ in a ring) is kept; integrated by 8-point Gauss
-        rules per layer segment."""
+        rules per ply (per layer without plies) segment."""
         m = self.model
         f = self.fields(u)
         elements = np.asarray(elements, np.int64)
