@@ -36,6 +36,9 @@ SECTIONS = [
     ("[imperfection]", schema.ImperfectionDef,
      "Optional: a geometric imperfection, moving the mesh nodes along the reference face's normal before the "
      "analysis (a buckling mode of `layershell buckle`, or a formula)."),
+    ("plies = [{...}] (layer)", schema.PlyDef,
+     "One ply of a layer's ply stack, bottom to top: integrated with its own Gauss points, material and angle "
+     "under the layer's directors."),
     ("[[stacks]]", schema.StackDef,
      "Optional: which elements carry which layers (default: all layers everywhere). Every element carries exactly "
      "one stack: selections must not overlap, and one stack without `where` and `set` takes the remaining "
@@ -102,7 +105,8 @@ def _type(ann, meta=()) -> str:
     origin, args = typing.get_origin(ann), typing.get_args(ann)
     if origin is typing.Annotated:
         return _type(args[0], meta + [m for a in args[1:] for m in (getattr(a, "metadata", None) or [a])])
-    if ann is schema.NumOrFormula or (origin in (typing.Union, types.UnionType) and set(args) == {float, str}):
+    if ann is schema.NumOrFormula or (origin in (typing.Union, types.UnionType)
+                                      and set(args) - {type(None)} == {float, str}):
         return "number or formula"
     if origin in (typing.Union, types.UnionType):
         arms = [a for a in args if a is not type(None)]

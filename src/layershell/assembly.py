@@ -46,7 +46,7 @@ def build_blocks(model: Model, dm: DofMap, elements: np.ndarray | None = None) -
             ly = model.layers[k]
             ref = layer_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
                               ly.angle, ly.direction, max(model.n_thickness, ly.directors),
-                              element=getattr(model, "element", "mitc"))
+                              element=getattr(model, "element", "mitc"), plies=ly.ply_table() if ly.plies else None)
             blocks.append(Block(k, el, dm.element_dofs(model, k, el), ref))
     return blocks
 

@@ -68,6 +68,9 @@ def model_hash(spec) -> str:
     ``model.title`` and ``model.units`` (comments and formatting do not matter either), and the
     mesh's node coordinates and connectivity (so an edited mesh file is detected too)."""
     src = spec.source.model_dump(mode="json", exclude={"output": True, "model": {"title", "units"}})
+    for layer in src.get("layers", []):  # a layer without plies hashes as it did before plies existed
+        if layer.get("plies") is None:
+            layer.pop("plies", None)
     h = hashlib.sha256(json.dumps(src, sort_keys=True, default=str).encode())
     mesh = spec.model.mesh
     h.update(np.ascontiguousarray(mesh.nodes, dtype=np.float64).tobytes())

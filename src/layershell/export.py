@@ -135,10 +135,18 @@ def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
     )
 
 
+def _ply_lattices(ly) -> list[np.ndarray]:
+    """Layer fractions Θ_L³ / H_L (27,) of the lattice points of each ply of layer ``ly``: its
+    bottom, middle and top (:func:`~.element.quadrature.ply_samples`)."""
+    from .element.quadrature import ply_samples
+
+    return [row[_LAT_M] for row in ply_samples([f for _, _, f in ly.ply_table()], 3)]
+
+
 def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray, sampling: str = "recovered", frame: str = "material",
                load_factor: float = 1.0):
-    """meshio.Mesh of the extruded shell: per element and layer a 3×3×3 lattice, 8 hexahedra;
-    stresses with recovered (or raw) transverse components, in material (or global) axes."""
+    """meshio.Mesh of the extruded shell: per element and layer (per ply of a ply stack) a 3×3×3
+    lattice, 8 hexahedra; stresses with recovered (or raw) transverse components, in material (or global) axes."""
     import meshio
 
     from .recovery import stress_points
@@ -156,24 +164,25 @@ def solid_mesh(model: Model, dm: DofMap, u_full: np.ndarray, sampling: str = "re
         ne = elems.size
         conn = mesh.elements[elems]  # (ne, 9)
         H = np.asarray(ly.thickness, float)[conn[:, _LAT_NODE]]  # (ne, 27) thickness at lattice nodes
-        thL = 0.5 * _LAT_M[None, :] * H
-        xi = np.broadcast_to(NODE_XI[_LAT_NODE, 0], (ne, 27))
-        eta = np.broadcast_to(NODE_XI[_LAT_NODE, 1], (ne, 27))
-        e_pts = np.repeat(elems, 27)
-        ps = stress_points(model, dm, u_full, e_pts, xi.ravel(), eta.ravel(), thL.ravel(), layers=k, local_theta=True,
-                           sampling=sampling, load_factor=load_factor)
-        cau = ps.stress("cauchy", frame)
-        pts.append(ps.X)
-        data["displacement"].append(ps.u)
-        data["cauchy"].append(stress_components(cau))
-        data["pk2"].append(stress_components(ps.stress("pk2", frame)))
-        data["von_mises"].append(von_mises(cau))
-        data["principal"].append(np.linalg.eigvalsh(cau)[:, ::-1])
-        base = n_pts + 27 * np.arange(ne)
-        cells.append((base[:, None, None] + _HEXES[None]).reshape(-1, 8))
-        cell_elem.append(np.repeat(elems, 8))
-        cell_layer.append(np.full(8 * ne, k, dtype=np.int64))
-        n_pts += 27 * ne
+        for s_lat in _ply_lattices(ly):  # one lattice per ply (the layer's own without plies)
+            thL = s_lat[None, :] * H
+            xi = np.broadcast_to(NODE_XI[_LAT_NODE, 0], (ne, 27))
+            eta = np.broadcast_to(NODE_XI[_LAT_NODE, 1], (ne, 27))
+            e_pts = np.repeat(elems, 27)
+            ps = stress_points(model, dm, u_full, e_pts, xi.ravel(), eta.ravel(), thL.ravel(), layers=k,
+                               local_theta=True, sampling=sampling, load_factor=load_factor)
+            cau = ps.stress("cauchy", frame)
+            pts.append(ps.X)
+            data["displacement"].append(ps.u)
+            data["cauchy"].append(stress_components(cau))
+            data["pk2"].append(stress_components(ps.stress("pk2", frame)))
+            data["von_mises"].append(von_mises(cau))
+            data["principal"].append(np.linalg.eigvalsh(cau)[:, ::-1])
+            base = n_pts + 27 * np.arange(ne)
+            cells.append((base[:, None, None] + _HEXES[None]).reshape(-1, 8))
+            cell_elem.append(np.repeat(elems, 8))
+            cell_layer.append(np.full(8 * ne, k, dtype=np.int64))
+            n_pts += 27 * ne
     if not pts:
         points = np.zeros((0, 3))
         hexes = np.zeros((0, 8), dtype=np.int64)

@@ -127,3 +127,29 @@ def rotate_stiffness(c_material: np.ndarray, frame: np.ndarray) -> np.ndarray:
     R = np.asarray(frame, float)
     K = R[..., i, I] * R[..., j, J] + np.where(i != j, R[..., j, I] * R[..., i, J], 0.0)
     return np.matmul(np.matmul(K, c_material), np.swapaxes(K, -1, -2))
+
+
+def laminate_equivalent(plies, name: str = "ply stack") -> Orthotropic:
+    """A homogenised orthotropic stand-in for a ply stack (``plies``: (material, angle in degrees,
+    thickness fraction) each), in the frame of the stack's angle 0: in-plane constants from the
+    thickness average of the plane-stress stiffness Q̄ (the membrane stiffness A/h; E1 = 1/a11,
+    E2 = 1/a22, ν12 = -a12/a11, G12 = 1/a66 with a = (A/h)⁻¹, the 16/26 coupling dropped),
+    E3 and the transverse shear moduli in series (the compliances averaged), ν23, ν31 and the
+    density averaged. For estimates only (penalties, process zones, mass), never for stresses."""
+    f = np.array([p[2] for p in plies], float)
+    f = f / f.sum()
+    Qbar = np.zeros((3, 3))
+    s33 = g13 = g23 = nu23 = nu31 = rho = 0.0
+    for (mat, ang, _), fr in zip(plies, f):
+        c, s = np.cos(np.deg2rad(ang)), np.sin(np.deg2rad(ang))
+        R = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # rows M_i in the stack frame
+        Cg = rotate_stiffness(mat.stiffness(), R)
+        Cip, Cn = Cg[np.ix_([0, 1, 5], [0, 1, 5])], Cg[np.ix_([0, 1, 5], [2])]
+        Qbar += fr * (Cip - Cn @ Cn.T / Cg[2, 2])
+        s33 += fr / mat.E3
+        g13 += fr * (c * c / mat.G31 + s * s / mat.G23)
+        g23 += fr * (s * s / mat.G31 + c * c / mat.G23)
+        nu23, nu31, rho = nu23 + fr * mat.nu23, nu31 + fr * mat.nu31, rho + fr * mat.density
+    a = np.linalg.inv(Qbar)
+    return Orthotropic(1 / a[0, 0], 1 / a[1, 1], 1 / s33, 1 / a[2, 2], 1 / g23, 1 / g13, -a[0, 1] / a[0, 0],
+                       nu23, nu31, rho, name)

@@ -13,10 +13,26 @@ from .mesh import Mesh
 
 
 @dataclass(frozen=True)
+class Ply:
+    """One ply of a layer's ply stack: material, angle (degrees about the normal, added to the
+    layer's angle) and its share of the layer thickness."""
+
+    material: Orthotropic
+    angle: float
+    fraction: float
+
+
+@dataclass(frozen=True)
 class Layer:
     """One layer: material, number of directors d (MODEL.md §2: u = Σ (Θ_L³)^l u_l, l=0..d),
     nodal thickness ``(n_nodes,)`` and material orientation (angle ω about the normal from the
-    tangent-plane projection of ``direction``, or from A_1 if ``direction`` is None)."""
+    tangent-plane projection of ``direction``, or from A_1 if ``direction`` is None).
+
+    With ``plies`` (bottom to top) the layer is a ply stack under its own directors: the element
+    integrates it ply by ply (:func:`layershell.element.quadrature.ply_rule`), stresses take the
+    ply's material and angle at their height, and ``material`` is the stack's homogenised
+    equivalent (:func:`layershell.material.laminate_equivalent`), used only by the estimates
+    (penalty stiffnesses, process zone, mass)."""
 
     name: str
     material: Orthotropic
@@ -24,6 +40,14 @@ class Layer:
     thickness: np.ndarray
     angle: float = 0.0
     direction: tuple[float, float, float] | None = None
+    plies: tuple[Ply, ...] = ()
+
+    def ply_table(self) -> tuple[tuple[Orthotropic, float, float], ...]:
+        """(material, angle ω in degrees, thickness fraction) per ply, bottom to top; a layer
+        without plies is one ply of its own material and angle."""
+        if not self.plies:
+            return ((self.material, self.angle, 1.0),)
+        return tuple((p.material, self.angle + p.angle, p.fraction) for p in self.plies)
 
 
 @dataclass(frozen=True)

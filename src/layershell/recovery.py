@@ -8,7 +8,8 @@ equilibrium equations integrated through the thickness (e.g. Noor & Burton 1989;
 Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recovery
 (Zienkiewicz & Zhu 1992):
 
-1. σ at 3 × 3 Gauss points of every element at d_L + 1 Gauss levels Θ_L³ of each layer L;
+1. σ at 3 × 3 Gauss points of every element at d_L + 1 Gauss levels Θ_L³ of each layer L (of
+   each ply of a ply-stack layer, whose stress is one polynomial per ply);
    patch recovery per node (least-squares complete quadratic in the tangent plane over the
    elements at the node, :func:`spr_operator`) gives nodal values of the tensor in Cartesian
    components at each level.
@@ -21,7 +22,7 @@ Rohwer 1997), fed with in-plane stresses smoothed by superconvergent patch recov
    interface shear of the thick plate of benchmarks/vs_solid.py on 8/16/32 elements, against
    0.20/0.13/0.10 % now.)
 3. ∂σ_α3/∂Θ³ = -D_α is integrated exactly (the levels carry the degree-d_L polynomial of each
-   layer) from the bottom face, where σ·(-A_3) equals the applied traction. σ33 follows from
+   layer, or ply) from the bottom face, where σ·(-A_3) equals the applied traction. σ33 follows from
    the shell equilibrium ∂(μ σ33)/∂Θ³ = μ ∫ ∂D_β/∂s_β - tr(B adj(I - Θ³B) σ_in) (shifter μ,
    curvature B: the hoop term of curved shells), by Gauss rules per layer; ∂D_β/∂s_β comes from
    the nodal D of step 2 (whose patch fits use mirror images at symmetry planes,
@@ -50,7 +51,7 @@ import scipy.sparse as sp
 
 from .dofs import DofMap
 from .element.geometry import surface_points
-from .element.quadrature import gauss_1d, gauss_2d
+from .element.quadrature import gauss_1d, gauss_2d, ply_of
 from .element.shape import EDGES, NODE_XI
 from .model import Model
 from .results import PointState, cauchy_stress, evaluate_points
@@ -67,8 +68,21 @@ def _sym(v: np.ndarray) -> np.ndarray:
 
 
 def levels(d: int) -> np.ndarray:
-    """The d + 1 Gauss levels ζ = Θ_L³ / H_L in (0, 1) at which a layer's stresses are sampled."""
+    """The d + 1 Gauss levels ζ in (0, 1) of one ply (of a layer without plies: the layer) at which
+    its stresses are sampled, a polynomial of degree d there."""
     return 0.5 * (np.asarray(gauss_1d(d + 1)[0]) + 1.0)
+
+
+def ply_segments(fractions) -> list[tuple[float, float]]:
+    """(start, share) of each ply as fractions of the layer thickness."""
+    f = np.asarray(fractions, float) / np.sum(fractions)
+    return list(zip(np.concatenate([[0.0], np.cumsum(f)[:-1]]), f))
+
+
+def layer_levels(ly) -> np.ndarray:
+    """The levels Θ_L³ / H_L of a layer: :func:`levels` in each of its plies, bottom to top."""
+    z = levels(ly.directors)
+    return np.concatenate([lo + fr * z for lo, fr in ply_segments([f for _, _, f in ly.ply_table()])])
 
 
 def _lagrange_integrals(z: np.ndarray, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -539,7 +553,7 @@ class Recovery:
         S, D = {}, {}
         for k, ly in enumerate(m.layers):
             els, spg, _, _ = self._geometry[k]
-            z = levels(ly.directors)
+            z = layer_levels(ly)
             nl = z.size
             e_all = np.repeat(els, ng * nl)
             xi = np.tile(np.repeat(pts[:, 0], nl), els.size)
@@ -594,7 +608,7 @@ class Recovery:
         shell equilibrium ∂(μ σ33)/∂z = μ ∫_0^z ∂D_β/∂s_β - tr(B adj(I - zB) σ_in) with the
         shifter μ = det(I - zB) and curvature B (MODEL.md §2, (2.12)), so that the hoop-stress
         term of curved shells (∂(r σ_r)/∂r = σ_φ in a ring) is kept; integrated by 8-point Gauss
-        rules per layer segment."""
+        rules per ply (per layer without plies) segment."""
         m = self.model
         f = self.fields(u)
         elements = np.asarray(elements, np.int64)
@@ -630,53 +644,59 @@ class Recovery:
             Bs = Bt[sel]
             for k in m.stacks[si]:
                 ly = m.layers[k]
-                zl = levels(ly.directors)
-                nl = zl.size
-                H = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
-                S_at = _sym(_at_points(spq.N[sel, 0], f.S[k][conn[sel]]))  # (p, nl, 3, 3)
-                # D_α = ∂σ_αβ/∂s_β (p, nl, 2) interpolated from its nodal values (second pass): the
+                n0 = levels(ly.directors).size
+                H_layer = np.einsum("pn,pn->p", spq.N[sel, 0], ly.thickness[conn[sel]])
+                S_all = _sym(_at_points(spq.N[sel, 0], f.S[k][conn[sel]]))  # (p, levels, 3, 3)
+                # D_α = ∂σ_αβ/∂s_β (p, levels, 2) interpolated from its nodal values (second pass): the
                 # derivative of the interpolated nodal stress at the point itself depends on the
                 # element at its nodes and converged only at first order (+4.7/+2.3/+1.1 % of the
                 # interface shear of benchmarks/vs_solid.py's plate at a node on 8/16/32 elements)
-                Dn = f.D[k][conn[sel]]  # (p, 9, nl, 3)
-                Da = np.matmul(_at_points(spq.N[sel, 0], Dn), T[sel])
-                Ev = np.matmul(np.swapaxes(Dn, 1, 2).reshape(ps_, nl, 27),
-                               gradN[sel].reshape(ps_, 27, 1))[..., 0]  # ∂D_β/∂s_β (p, nl)
-                Sin = np.einsum("pia,plij,pjb->plab", T[sel], S_at, T[sel], optimize=True)  # (p, nl, 2, 2), tangent frame
-                Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
+                Dn_all = f.D[k][conn[sel]]  # (p, 9, levels, 3)
+                fractions = [fr for _, _, fr in ly.ply_table()]
+                in_layer = np.flatnonzero(layers[sel] == k)
+                s_layer = thetaL[sel[in_layer]] / H_layer[in_layer]
+                ply_here = ply_of(fractions, s_layer)
+                for j, (lo, fr) in enumerate(ply_segments(fractions)):  # each ply: one polynomial in Θ³
+                    zl, nl, H = levels(ly.directors), n0, fr * H_layer
+                    S_at, Dn = S_all[:, j * n0:(j + 1) * n0], Dn_all[:, :, j * n0:(j + 1) * n0]
+                    Da = np.matmul(_at_points(spq.N[sel, 0], Dn), T[sel])
+                    Ev = np.matmul(np.swapaxes(Dn, 1, 2).reshape(ps_, nl, 27),
+                                   gradN[sel].reshape(ps_, 27, 1))[..., 0]  # ∂D_β/∂s_β (p, nl)
+                    Sin = np.einsum("pia,plij,pjb->plab", T[sel], S_at, T[sel], optimize=True)  # tangent frame
+                    Vinv = np.linalg.inv(zl[:, None] ** np.arange(nl))
 
-                def G_at(s):  # G = μ F - K at layer fractions s (p, q)
-                    a1 = np.matmul(s[..., None] ** (np.arange(nl) + 1) / (np.arange(nl) + 1), Vinv)
-                    L = np.matmul(s[..., None] ** np.arange(nl), Vinv)
-                    F = F_below[:, None] + H[:, None] * np.matmul(a1, Ev[..., None])[..., 0]
-                    z = z0[:, None] + s * H[:, None]
-                    M = I2 - z[..., None, None] * Bs[:, None]
-                    mu = np.linalg.det(M)
-                    adj = np.trace(M, axis1=-2, axis2=-1)[..., None, None] * I2 - M
-                    S2 = np.matmul(L, Sin.reshape(ps_, nl, 4)).reshape(L.shape[:2] + (2, 2))
-                    K = np.trace(np.matmul(np.matmul(Bs[:, None], adj), S2), axis1=-2, axis2=-1)
-                    return mu * F - K
+                    def G_at(s, nl=nl, Vinv=Vinv, F_below=F_below, H=H, Ev=Ev, z0=z0, Sin=Sin):
+                        a1 = np.matmul(s[..., None] ** (np.arange(nl) + 1) / (np.arange(nl) + 1), Vinv)
+                        L = np.matmul(s[..., None] ** np.arange(nl), Vinv)
+                        F = F_below[:, None] + H[:, None] * np.matmul(a1, Ev[..., None])[..., 0]
+                        z = z0[:, None] + s * H[:, None]
+                        M = I2 - z[..., None, None] * Bs[:, None]
+                        mu = np.linalg.det(M)
+                        adj = np.trace(M, axis1=-2, axis2=-1)[..., None, None] * I2 - M
+                        S2 = np.matmul(L, Sin.reshape(ps_, nl, 4)).reshape(L.shape[:2] + (2, 2))
+                        K = np.trace(np.matmul(np.matmul(Bs[:, None], adj), S2), axis1=-2, axis2=-1)
+                        return mu * F - K  # G = μ F - K at ply fractions s (p, q)
 
-                def integral(s_end):  # ∫ over the layer from its bottom to fraction s_end (p,)
-                    s = 0.5 * (xg + 1) * s_end[:, None]
-                    return 0.5 * s_end * H * (G_at(s) @ wg)
+                    def integral(s_end, G_at=G_at, H=H):  # ∫ over the ply from its bottom to fraction s_end (p,)
+                        s = 0.5 * (xg + 1) * s_end[:, None]
+                        return 0.5 * s_end * H * (G_at(s) @ wg)
 
-                w1, _ = _lagrange_integrals(zl, np.ones(1))
-                hl = np.flatnonzero(layers[sel] == k)
-                if hl.size:
-                    here = sel[hl]
-                    s_q = thetaL[here] / H[hl]
-                    a1, _ = _lagrange_integrals(zl, s_q)
-                    tau[here] = D_below[hl] + H[hl, None] * np.einsum("pl,pla->pa", a1, Da[hl])
-                    s_all = np.zeros(ps_)
-                    s_all[hl] = s_q
-                    part = integral(s_all)
-                    G_int[here] = Gacc[hl] + part[hl]
-                    z_at[here] = z0[hl] + thetaL[here]
-                Gacc = Gacc + integral(np.ones(ps_))
-                D_below = D_below + H[:, None] * np.einsum("l,pla->pa", w1[0], Da)
-                F_below = F_below + H * (Ev @ w1[0])
-                z0 = z0 + H
+                    w1, _ = _lagrange_integrals(zl, np.ones(1))
+                    hl = in_layer[ply_here == j]
+                    if hl.size:
+                        here = sel[hl]
+                        s_q = np.clip((thetaL[here] / H_layer[hl] - lo) / fr, 0.0, None)
+                        a1, _ = _lagrange_integrals(zl, s_q)
+                        tau[here] = D_below[hl] + H[hl, None] * np.einsum("pl,pla->pa", a1, Da[hl])
+                        s_all = np.zeros(ps_)
+                        s_all[hl] = s_q
+                        part = integral(s_all)
+                        G_int[here] = Gacc[hl] + part[hl]
+                        z_at[here] = z0[hl] + s_q * H[hl]
+                    Gacc = Gacc + integral(np.ones(ps_))
+                    D_below = D_below + H[:, None] * np.einsum("l,pla->pa", w1[0], Da)
+                    F_below = F_below + H * (Ev @ w1[0])
+                    z0 = z0 + H
             tau_top[sel] = D_below
             G_top[sel] = Gacc
             htot[sel] = z0

@@ -13,6 +13,7 @@ import numpy as np
 from .dofs import DofMap
 from .element.geometry import shell_basis, surface_points
 from .element.kernel import basis_gradients, green_lagrange, material_frame, voigt_to_matrix
+from .element.quadrature import ply_of
 from .material import rotate_stiffness
 from .model import Model
 
@@ -133,8 +134,7 @@ def evaluate_points(
                              xi[sel], eta[sel], thL, model.nonlinear, groups=elements[sel])
         else:
             Ev = green_lagrange(Hg, model.nonlinear)
-        M = material_frame(sp, ly.angle, ly.direction)[:, 0]
-        C = rotate_stiffness(ly.material.stiffness(), M)
+        M, C = _ply_law(ly, sp, thL / sp.interpolate(ly.thickness[conn])[:, 0])
         S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
         sig = cauchy_stress(F, S)
         # deformed frame (2.101)-(2.104): m1 = F M1/|F M1|, m3 = n = g1 x g2/|.|
@@ -147,6 +147,20 @@ def evaluate_points(
         out["F"][sel], out["S"][sel], out["sigma"][sel], out["M"][sel], out["m"][sel] = F, S, sig, M, m
         out["E"][sel] = voigt_to_matrix(Ev * np.array([1, 1, 1, 0.5, 0.5, 0.5]))
     return PointState(X, u, out["F"], out["E"], out["S"], out["sigma"], out["M"], out["m"], layers.copy())
+
+
+def _ply_law(ly, sp, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Material frame (p, 3, 3) and Cartesian stiffness (p, 6, 6) at layer fractions ``s`` (p,)
+    of layer ``ly``: those of the ply there (the lower one on a ply boundary)."""
+    table = ly.ply_table()
+    ply = ply_of([f for _, _, f in table], s)
+    M, C = np.empty((s.size, 3, 3)), np.empty((s.size, 6, 6))
+    for j in np.unique(ply):
+        mat, ang, _ = table[j]
+        at = ply == j
+        Mj = material_frame(sp, ang, ly.direction)[:, 0]
+        M[at], C[at] = Mj[at], rotate_stiffness(mat.stiffness(), Mj[at])
+    return M, C
 
 
 def locate(model: Model, point, tol: float | None = None) -> tuple[int, float, float, float]:

@@ -32,13 +32,15 @@ def through_thickness(spec_profile, model, dm, u, load_factor: float = 1.0):
     e, x, y, _ = locate(model, pr.point)
     conn = model.mesh.elements[e]
     out = {}
+    from .element.quadrature import ply_samples
     from .element.shape import quad9
 
     N, _, _ = quad9(np.array([x]), np.array([y]))
     for k in model.stacks[model.element_stack[e]]:
         H = float(N[0] @ model.layers[k].thickness[conn])
         off = float(N[0] @ model.offset(k)[conn])
-        thL = np.linspace(0.0, H, pr.points_per_layer)
+        # points_per_layer samples in each ply (in the layer itself without plies)
+        thL = H * ply_samples([f for _, _, f in model.layers[k].ply_table()], pr.points_per_layer).ravel()
         ps = stress_points(model, dm, u, np.full(thL.size, e), x, y, thL, np.full(thL.size, k), local_theta=True,
                            sampling=getattr(pr, "sampling", "recovered"), load_factor=load_factor)
         T = ps.stress(pr.measure, getattr(pr, "frame", "material"))

@@ -31,7 +31,7 @@ import numpy as np
 from ..material import Orthotropic, rotate_stiffness
 from ..threads import blas_single_thread
 from .geometry import SurfacePoints, shell_basis, surface_points
-from .quadrature import gauss_1d, gauss_2d
+from .quadrature import gauss_2d, ply_rule
 
 _I3 = np.eye(3)
 
@@ -79,6 +79,21 @@ def material_frame(sp: SurfacePoints, angle_deg: float = 0.0, direction=None) ->
     return np.stack([M1, M2, A3], axis=-2)
 
 
+def ply_stiffness(sp: SurfacePoints, plies, direction, ply: np.ndarray) -> np.ndarray:
+    """Cartesian stiffness ``(e, q, z, 6, 6)`` at the thickness points of ply index ``ply (z,)``,
+    each from its ply's material and angle (``plies``: (material, angle, fraction) per ply)."""
+    per_ply = np.stack([rotate_stiffness(mat.stiffness(), material_frame(sp, ang, direction))
+                        for mat, ang, _ in plies])  # (plies, e, q, 6, 6)
+    return np.moveaxis(per_ply[ply], 0, 2)
+
+
+def thickness_rule(plies, material, angle_deg: float, n: int):
+    """The ply table (one ply of ``material`` and ``angle_deg`` without ``plies``) and its
+    thickness rule (:func:`.quadrature.ply_rule`)."""
+    plies = ((material, angle_deg, 1.0),) if plies is None else tuple(plies)
+    return plies, ply_rule(n, [f for _, _, f in plies])
+
+
 def basis_gradients(sp: SurfacePoints, Ginv: np.ndarray, thetaL: np.ndarray, d: int) -> np.ndarray:
     """Material gradients of phi_(n,l) = N_n (Θ_L)^l at points, ``(e, q, z, 9*(d+1), 3)``."""
     l = np.arange(d + 1)
@@ -108,6 +123,7 @@ def layer_block(
     n_thickness: int = 3,
     n_inplane: int = 3,
     element: str = "full",
+    plies=None,
 ):
     """Precompute one layer for elements with nodal coordinates ``X (e, 9, 3)``.
 
@@ -116,17 +132,20 @@ def layer_block(
     ``element``: "full" (fully integrated, this module) or "mitc" (assumed strain,
     :mod:`.mitc`; returns a :class:`~.mitc.MitcBlock` and uses at least d + 1 thickness points,
     with fewer the (Θ_L)^d director of d ≥ 3 has zero-energy modes once the shear is tied).
+    ``plies``: (material, angle, thickness fraction) per ply, bottom to top, instead of
+    ``material`` and ``angle_deg``: ``n_thickness`` Gauss points in each ply, C per point from
+    its ply (:meth:`layershell.model.Layer.ply_table`).
     """
     if element == "mitc":
         from .mitc import mitc_block
 
         if n_inplane != 3:
             raise ValueError("the MITC9 element needs the 3 x 3 in-plane rule")
-        return mitc_block(X, H_below, H, d, material, angle_deg, direction, max(n_thickness, d + 1))
+        return mitc_block(X, H_below, H, d, material, angle_deg, direction, max(n_thickness, d + 1), plies=plies)
     if element != "full":
         raise ValueError(f"element: unknown element {element!r} (use 'mitc' or 'full')")
     pts, w2 = gauss_2d(n_inplane)
-    zeta, wz = gauss_1d(n_thickness)
+    plies, (zeta, wz, ply) = thickness_rule(plies, material, angle_deg, n_thickness)
     sp = surface_points(X, pts[:, 0], pts[:, 1])
     Hq = sp.interpolate(H)  # (e, q)
     Hb = sp.interpolate(H_below)
@@ -134,10 +153,8 @@ def layer_block(
     G, Ginv, detG = shell_basis(sp, Hb[..., None] + thetaL)
     g = basis_gradients(sp, Ginv, thetaL, d)
     dV = detG * (w2[:, None] * wz[None, :]) * (0.5 * Hq[..., None])
-    frame = material_frame(sp, angle_deg, direction)  # (e, q, 3, 3)
-    C = rotate_stiffness(material.stiffness(), frame)  # (e, q, 6, 6)
     e, q, z = dV.shape
-    C = np.ascontiguousarray(np.broadcast_to(C[:, :, None], (e, q, z, 6, 6)).reshape(e, q * z, 6, 6))
+    C = np.ascontiguousarray(ply_stiffness(sp, plies, direction, ply).reshape(e, q * z, 6, 6))
     dV = dV.reshape(e, q * z)
     return LayerBlock(d, np.ascontiguousarray(g.reshape(e, q * z, -1, 3)), dV, C, stiffness_factor(C, dV))
 

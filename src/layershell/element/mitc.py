@@ -71,7 +71,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from ..material import Orthotropic, rotate_stiffness
+from ..material import Orthotropic
 from .geometry import shell_basis, surface_points
 from .quadrature import gauss_1d, gauss_2d
 
@@ -308,24 +308,25 @@ def strain_frames(X, H_below, H, points, zeta, frame: str = "center"):
 
 
 def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 0.0, direction=None,
-               n_thickness: int = 3, full: bool = False, frame: str = "center", consistent: bool = True) -> MitcBlock:
+               n_thickness: int = 3, full: bool = False, frame: str = "center", consistent: bool = True,
+               plies=None) -> MitcBlock:
     """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`;
     ``frame`` see :func:`strain_frames`; ``consistent=False`` leaves out the consistency
-    correction of the tying, module docstring, for comparison)."""
-    from .kernel import material_frame
+    correction of the tying, module docstring, for comparison). With ``plies`` the thickness
+    levels are those of :func:`.quadrature.ply_rule`, each tied as any level, C from its ply."""
+    from .kernel import ply_stiffness, thickness_rule
 
     tie = tying(full)
-    zeta, wz = gauss_1d(n_thickness)
+    plies, (zeta, wz, ply) = thickness_rule(plies, material, angle_deg, n_thickness)
     gp, w2 = gauss_2d(3)
     F, M, _, _, detP, spP, thL = strain_frames(X, H_below, H, tie.points, zeta, frame)  # sampling points
     v = np.ascontiguousarray(tie_correction(tie, detP, spP.interpolate(H))) if consistent else None
     Fq, _, _, _, detG, sg, _ = strain_frames(X, H_below, H, gp, zeta, frame)  # Gauss points
     Hq = sg.interpolate(H)
     dV = detG * (w2[:, None] * wz[None, :]) * (0.5 * Hq[..., None])  # (e, q, z)
-    mframe = material_frame(sg, angle_deg, direction)
-    C = rotate_stiffness(material.stiffness(), mframe)  # (e, q, 6, 6)
+    C = ply_stiffness(sg, plies, direction, ply)  # (e, q, z, 6, 6)
     T = covariant_map(np.linalg.inv(Fq))  # (e, q, z, 6, 6): rows of F⁻¹ = dual vectors F^i
-    Ct = np.einsum("eqzVc,eqVW,eqzWd->ezqcd", T, C, T) * dV.transpose(0, 2, 1)[..., None, None]
+    Ct = np.einsum("eqzVc,eqzVW,eqzWd->ezqcd", T, C, T) * dV.transpose(0, 2, 1)[..., None, None]
     Ct = np.ascontiguousarray(0.5 * (Ct + np.swapaxes(Ct, -1, -2)))
     L, split = None, 0
     if np.all(dV > 0):
@@ -341,7 +342,7 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
         except np.linalg.LinAlgError:
             L, split = None, 0
     e, q, z = dV.shape
-    Cz = np.ascontiguousarray(np.broadcast_to(C[:, None], (e, z, q, 6, 6)).reshape(e, z * q, 6, 6))
+    Cz = np.ascontiguousarray(C.transpose(0, 2, 1, 3, 4).reshape(e, z * q, 6, 6))
     N, dN, _ = _quad9(tie.points)
     return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
                      np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),

@@ -23,8 +23,8 @@ from pydantic import BaseModel, ValidationError
 from .. import mesh as meshmod
 from ..element.shape import EDGES
 from ..formula import FormulaError
-from ..material import MaterialError, Orthotropic
-from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, SurfaceLoad, Symmetry, Tie
+from ..material import MaterialError, Orthotropic, laminate_equivalent
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, Ply, SurfaceLoad, Symmetry, Tie
 from ..solver.newton import NewtonSettings
 from . import schema
 from .errors import XYZ, InputError  # defined apart: io/probes.py needs them without importing this module
@@ -870,6 +870,19 @@ def _check_slender(model: Model) -> None:
                          "mesh (e.g. mm against m, or the mesh file's 'scale')")
 
 
+def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray) -> Layer:
+    """The model's layer of ``ld`` (materials ``mats``, nodal thickness ``th``); a ply stack takes
+    its homogenised equivalent as the layer material (estimates only, :class:`Layer`)."""
+    direction = tuple(ld.direction) if ld.direction is not None else None
+    if ld.plies is None:
+        return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction)
+    total = sum(p.thickness for p in ld.plies)
+    plies = tuple(Ply(mats[p.material], p.angle, p.thickness / total) for p in ld.plies)
+    equivalent = laminate_equivalent([(p.material, p.angle, p.fraction) for p in plies],
+                                     name=f"plies of layer '{ld.name}'")
+    return Layer(ld.name, equivalent, ld.directors, th, ld.angle, direction, plies)
+
+
 def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     try:
         with np.errstate(all="ignore"), warnings.catch_warnings():
@@ -888,7 +901,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     index = {n: i for i, n in enumerate(names)}
     layers = []
     for i, ld in enumerate(mf.layers):
-        th = _nodal_values(m, ld.thickness, f"layers[{i}].thickness", **m.node_fields)  # h_meridian: revolution
+        given = ld.thickness if ld.plies is None or ld.thickness is not None else sum(p.thickness for p in ld.plies)
+        th = _nodal_values(m, given, f"layers[{i}].thickness", **m.node_fields)  # h_meridian: revolution
         if not np.all((th > 0) & np.isfinite(th)):
             bad = np.flatnonzero(~((th > 0) & np.isfinite(th)))
             raise InputError(f"'layers[{i}].thickness': must be positive and finite at every node, but is "
@@ -903,8 +917,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              "computed in floating point; check the units of the thickness and of the mesh")
         if ld.direction is not None:
             _vec(ld.direction, f"layers[{i}].direction")
-        layers.append(Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle,
-                            tuple(ld.direction) if ld.direction is not None else None))
+        layers.append(_layer(ld, mats, th))
 
     def layer_idx(name, field):
         if name is None:

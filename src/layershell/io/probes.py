@@ -118,7 +118,7 @@ class Probe:
         (``direction`` projected on the tangent plane), e3 = A3, e2 = e3 × e1:
         n = ∫ e1·σ·e1 dΘ³, m = ∫ e1·σ·e1 (Θ³ − Θ_m) dΘ³, q = ∫ e1·σ·e3 dΘ³, nt, mt with e2
         for the second index; Cauchy stresses, through all layers of the stack (Gauss points
-        per layer), without the shifter (per unit width of the reference surface). A point on
+        per ply of each layer), without the shifter (per unit width of the reference surface). A point on
         element boundaries gets the mean over the elements that share it (the stresses of the
         displacement element jump there)."""
 
@@ -128,14 +128,14 @@ class Probe:
 
     def _resultant_at(self, model, dm, u, e: int, xi: float, eta: float, n_gauss: int) -> float:
         from ..element.geometry import surface_points
-        from ..element.quadrature import gauss_1d
+        from ..element.quadrature import ply_rule
 
         stack = model.stacks[model.element_stack[e]]
         conn = model.mesh.elements[e]
         sp = surface_points(model.mesh.nodes[conn][None], np.array([[xi]]), np.array([[eta]]), per_element=True)
-        t, w = gauss_1d(n_gauss)
         th, wt, lay = [], [], []
         for k in stack:
+            t, w, _ = ply_rule(n_gauss, [f for _, _, f in model.layers[k].ply_table()])  # Gauss points per ply
             off = float(sp.interpolate(model.offset(k)[conn][None])[0, 0])
             H = float(sp.interpolate(model.layers[k].thickness[conn][None])[0, 0])
             th.append(off + 0.5 * H * (t + 1.0))

@@ -70,7 +70,8 @@ class ModelSettings(Strict):
         "resultants force/length, areas length²); nothing is converted"))
     nonlinear: bool = Field(True, description="geometrically nonlinear (Green-Lagrange) or linear")
     thickness_points: PositiveInt = Field(
-        3, le=10, description="Gauss points through each layer (at least d are used: d = 4 needs 4)")
+        3, le=10, description="Gauss points through each layer, or through each ply of a layer "
+        "with 'plies' (at least d are used: d = 4 needs 4)")
     element: Literal["mitc", "full"] = Field(
         "mitc", description="shell element: 'mitc' = assumed-strain MITC9 (membrane and transverse shear "
                             "strains tied, no locking in thin shells; at least d + 1 thickness points), "
@@ -260,15 +261,35 @@ class OrthotropicMat(Strict):
 Material = Annotated[Union[Isotropic, OrthotropicMat], Field(discriminator="type")]
 
 
+class PlyDef(Strict):
+    material: str = Field(description="name of a [materials.NAME] table")
+    angle: FiniteFloat = Field(0.0, description=(
+        "ply angle in degrees about the normal from the layer's material axis 1 (its 'direction', or the first "
+        "coordinate line), added to the layer's 'angle'"))
+    thickness: PositiveFloat = Field(description="ply thickness (length)")
+
+    @field_validator("angle", mode="before")
+    @classmethod
+    def _number(cls, v):
+        if isinstance(v, str) or not isinstance(v, (int, float)):
+            raise ValueError(f"the ply angle must be a number of degrees (got {v!r}); write e.g. angle = 45 or "
+                             "angle = -45, without quotes or units")
+        return v
+
+
 class LayerDef(Strict):
     name: str = Field(min_length=1, description="name of the layer, used by stacks, supports, loads and probes")
-    material: str = Field(description="name of a [materials.NAME] table")
-    thickness: NumOrFormula = Field(description=(
-        "layer thickness (length); a formula is evaluated at the nodes"))
+    material: str | None = Field(None, description="name of a [materials.NAME] table (not with 'plies')")
+    thickness: NumOrFormula | None = Field(None, description=(
+        "layer thickness (length); a formula is evaluated at the nodes. With 'plies' it may be left out (the "
+        "sum of the ply thicknesses); if given it must equal that sum"))
     directors: int = Field(3, ge=0, le=4, description=(
         "polynomial order d of the displacement through the layer: u = Σ_{l=0..d} (Θ³)^l u_l"))
     angle: FiniteFloat = Field(0.0, description="material angle ω in degrees about the normal")
     direction: Vec3 | None = Field(None, description="global direction projected on the surface as material axis 1")
+    plies: list[PlyDef] | None = Field(None, min_length=1, description=(
+        "ply stack inside the layer, bottom to top, instead of 'material': [{material = 'cfrp', angle = 0, "
+        "thickness = 0.125}, ...]; integrated ply by ply under the layer's directors, stresses per ply"))
 
     @field_validator("thickness")
     @classmethod
@@ -277,6 +298,34 @@ class LayerDef(Strict):
             raise ValueError(f"must be positive and finite (got {v}); give the layer thickness as a positive "
                              "number or a formula in x, y, z")
         return v
+
+
+def _check_layer_material(ly: LayerDef, i: int) -> None:
+    """One material or a ply stack, and a layer thickness that the plies agree with."""
+    at = f"layers[{i}]"
+    if ly.plies is None:
+        if ly.material is None:
+            raise ValueError(f"'{at}.material': required key is missing; give the layer a 'material' (a "
+                             "[materials.NAME] table) or a ply stack 'plies = [{material = ..., angle = ..., "
+                             "thickness = ...}, ...]'")
+        if ly.thickness is None:
+            raise ValueError(f"'{at}.thickness': required key is missing; add 'thickness = ...' (a number or a "
+                             "formula in x, y, z) to the layer")
+        return
+    if ly.material is not None:
+        raise ValueError(f"'{at}.material': a layer has either one material or a ply stack, but this one has "
+                         f"material = '{ly.material}' and 'plies'; each ply names its own material, so leave out "
+                         "the layer's 'material' (or give the layer one material and no 'plies')")
+    total = sum(p.thickness for p in ly.plies)
+    if isinstance(ly.thickness, str):
+        raise ValueError(f"'{at}.thickness': a layer with 'plies' is {total:.12g} thick (the sum of its plies), so "
+                         f"its thickness cannot be the formula '{ly.thickness}'; leave 'thickness' out or give "
+                         f"thickness = {total:.12g}")
+    if ly.thickness is not None and abs(ly.thickness - total) > 1e-9 * ly.thickness:
+        listed = " + ".join(f"{p.thickness:g}" for p in ly.plies)
+        raise ValueError(f"'{at}.thickness': the plies are {listed} = {total:.12g} thick together, but the layer "
+                         f"thickness is {ly.thickness:.12g} (they must agree to 1e-9 relative); fix the ply "
+                         "thicknesses, or leave out the layer's 'thickness' so that it follows from the plies")
 
 
 class StackDef(Strict):
@@ -617,7 +666,8 @@ class ProfileDef(Strict):
         "through the thickness, or 'raw' values from the displacement derivatives (as [[probes]] sampling)")
     frame: Literal["material", "global"] = Field(
         "material", description="components in the layers' material axes (default) or the global x, y, z axes")
-    points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer")
+    points_per_layer: int = Field(21, ge=2, le=1001, description="sampling points through each layer (through each ply of a "
+                                  "layer with 'plies')")
 
 
 class LineDef(Strict):
@@ -827,9 +877,13 @@ class ModelFile(Strict):
             raise ValueError(f"'layers': layer names must be unique, but {sorted(dup)} appear more than once; "
                              "rename the layers")
         for i, ly in enumerate(self.layers):
-            if ly.material not in self.materials:
-                raise ValueError(f"'layers[{i}].material': unknown material '{ly.material}'; defined: "
-                                 f"{sorted(self.materials)} (fix the name or add a [materials.{ly.material}] table)")
+            _check_layer_material(ly, i)
+            used = [(f"layers[{i}].material", ly.material)] if ly.plies is None else [
+                (f"layers[{i}].plies[{j}].material", p.material) for j, p in enumerate(ly.plies)]
+            for at, mat in used:
+                if mat not in self.materials:
+                    raise ValueError(f"'{at}': unknown material '{mat}'; defined: {sorted(self.materials)} (fix the "
+                                     f"name or add a [materials.{mat}] table)")
         zs = self.output.zone_steps
         n_steps = len(self.steps.factors) if self.steps.factors is not None else self.steps.n
         if zs and max(zs) > n_steps:

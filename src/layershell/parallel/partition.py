@@ -33,7 +33,7 @@ def element_weights(model: Model) -> np.ndarray:
         for k in stack:
             ly = model.layers[k]
             m = 27 * (ly.directors + 1)
-            w_stack[si] += m * m * max(model.n_thickness, ly.directors)
+            w_stack[si] += m * m * max(model.n_thickness, ly.directors) * len(ly.ply_table())  # points per ply
     return w_stack[model.element_stack]
 
 
