@@ -148,7 +148,8 @@ def plate_with_ellipse(lx: float, ly: float, center, semi_axes, front_size: floa
 
     Element sets: 'inside' (the ellipse's interior), 'ring', 'outer', 'outside' (ring and outer).
     Node sets: 'front' (on the ellipse), 'inside' (the nodes of the inside elements, front
-    included), 'xmin', 'xmax', 'ymin', 'ymax' (the plate edges)."""
+    included), 'interior' (those strictly inside the front), 'xmin', 'xmax', 'ymin', 'ymax' (the
+    plate edges)."""
     a, b = (float(v) for v in semi_axes)
     c = np.asarray(center, float)[:2]
     o = np.asarray(origin, float)
@@ -199,6 +200,7 @@ def plate_with_ellipse(lx: float, ly: float, center, semi_axes, front_size: floa
     edge = ids[-1]
     tol = 1e-9 * max(lx, ly)
     node_sets = {"front": ids[ring_start], "inside": np.unique(elements[:n_in]),
+                 "interior": np.setdiff1d(elements[:n_in], ids[ring_start]),
                  "xmin": edge[np.abs(nodes[edge, 0] - box[0, 0]) <= tol],
                  "xmax": edge[np.abs(nodes[edge, 0] - box[1, 0]) <= tol],
                  "ymin": edge[np.abs(nodes[edge, 1] - box[0, 1]) <= tol],

@@ -415,8 +415,9 @@ def _mesh_size(md) -> tuple[int, str] | None:
         return n_mer * md.n_circ, "(elements along the meridian) × n_circ"
     if md.type == "plate_with_circle":
         a, b = (md.radius, md.radius) if md.radius is not None else md.semi_axes
-        around = math.pi * (a + b) / md.front_size  # elements along the front, about
-        return int(around * (around / 8 + md.ring_layers + (md.outer_layers or 10))), "the front's elements × layers"
+        around = min(math.pi * (a + b) / md.front_size, 1e12)  # elements along the front, about
+        count = around * (around / 8 + md.ring_layers + (md.outer_layers or 10))
+        return int(min(count, 1e18)), "(elements along the front) × (layers across the plate)"
     return None
 
 

@@ -243,6 +243,11 @@ class PlateWithCircleMesh(MeshBase):
     def _fits(self):
         if (self.radius is None) == (self.semi_axes is None):
             raise ValueError("give either radius (a circle) or semi_axes = [a, b] (an ellipse), not both or neither")
+        sizes = {"lx": self.lx, "ly": self.ly, "radius": self.radius, "front_size": self.front_size,
+                 "ring_width": self.ring_width, "semi_axes": max(self.semi_axes or [0.0])}
+        for name, v in sizes.items():
+            if v is not None and not math.isfinite(v):
+                raise ValueError(f"{name} must be a finite number (got {v}); give a length in the model's units")
         a, b = (self.radius, self.radius) if self.radius is not None else self.semi_axes
         x0, y0 = self.origin[0], self.origin[1]
         cx, cy = self.center
