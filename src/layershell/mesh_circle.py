@@ -139,6 +139,58 @@ def _geometric(n: int, first: float) -> np.ndarray:
     return out
 
 
+def _check_fits(a: float, b: float, c: np.ndarray, box: np.ndarray, front_size: float, ring_width: float,
+                ring_layers: int, outer_layers: int | None) -> None:
+    clear = np.array([c[0] - a - box[0, 0], box[1, 0] - c[0] - a, c[1] - b - box[0, 1], box[1, 1] - c[1] - b])
+    if min(a, b, front_size, ring_width) <= 0 or ring_layers < 1 or (outer_layers is not None and outer_layers < 1):
+        raise MeshError("semi-axes, front_size, ring_width must be positive and ring_layers, outer_layers at least 1")
+    if clear.min() <= 0:
+        raise MeshError(f"the ellipse leaves the plate (its distance to the edges xmin, xmax, ymin, ymax is "
+                        f"{', '.join(f'{v:.6g}' for v in clear)}); move the centre or shrink the semi-axes")
+    if clear.min() <= ring_width:
+        raise MeshError(f"the ring of width {ring_width:.6g} reaches an edge (the ellipse is {clear.min():.6g} from "
+                        f"the nearest edge); give ring_width below {clear.min():.6g}")
+
+
+def _rows(c, box, a, b, front_size, ring_width, ring_layers, outer_layers):
+    """Node positions: the core's (ids 0..), its id grid and boundary loop, and the rows of the
+    O-grid from the core's boundary outward (inner O-ring, ring, transition), 2N points each;
+    the numbers of inner O-ring and transition layers."""
+    t, m1, m2 = front_parameters(a, b, front_size)
+    direction = np.stack([np.cos(t), np.sin(t)], -1)
+    front = c + np.stack([a * np.cos(t), b * np.sin(t)], -1)
+    ring_out = front + ring_width * direction
+    core_uv, core_idx, loop = _core(m1, m2)
+    core_xy = c + core_uv * np.array([a, b])
+    n_inner = max(1, int(round((1 - CORE_FRACTION) * min(a, b) / front_size)))  # square-ish inner elements
+    side = _side_points(c, box, t, a + ring_width, b + ring_width)
+    reach = np.linalg.norm(side - ring_out, axis=1)  # length of each radial line of the transition
+    layer = ring_width / ring_layers
+    if outer_layers is None:  # enough layers to grow from a ring layer to the farthest corner
+        outer_layers = max(1, int(np.ceil(np.log1p((OUTER_GROWTH - 1) * reach.max() / layer) / np.log(OUTER_GROWTH))))
+    r_in = np.linspace(0.0, 1.0, 2 * n_inner + 1)[1:-1]
+    r_ring = np.linspace(0.0, 1.0, 2 * ring_layers + 1)[1:]
+    r_out = _geometric(outer_layers, layer / np.median(reach))[1:]
+    rows = ([(1 - r) * core_xy[loop] + r * front for r in r_in] + [front]  # the front exactly on the ellipse
+            + [front + r * ring_width * direction for r in r_ring] + [(1 - r) * ring_out + r * side for r in r_out])
+    return core_xy, core_idx, loop, rows, n_inner, outer_layers
+
+
+def _sets(nodes: np.ndarray, elements: np.ndarray, front: np.ndarray, edge: np.ndarray, counts, box: np.ndarray,
+          tol: float) -> tuple[dict, dict]:
+    """Node and element sets (see :func:`plate_with_ellipse`); ``front``/``edge``: the node ids on
+    the ellipse and on the plate's boundary; ``counts``: elements inside, in the ring, outer."""
+    n_in, n_ring, n_out = counts
+    node_sets = {"front": front, "inside": np.unique(elements[:n_in]),
+                 "interior": np.setdiff1d(elements[:n_in], front)}
+    for name, axis, at in (("xmin", 0, box[0, 0]), ("xmax", 0, box[1, 0]), ("ymin", 1, box[0, 1]),
+                           ("ymax", 1, box[1, 1])):
+        node_sets[name] = np.sort(edge[np.abs(nodes[edge, axis] - at) <= tol])
+    element_sets = {"inside": np.arange(n_in), "ring": n_in + np.arange(n_ring),
+                    "outer": n_in + n_ring + np.arange(n_out), "outside": n_in + np.arange(n_ring + n_out)}
+    return node_sets, element_sets
+
+
 def plate_with_ellipse(lx: float, ly: float, center, semi_axes, front_size: float, ring_width: float,
                        ring_layers: int, outer_layers: int | None = None, origin=(0.0, 0.0, 0.0),
                        normal: str = "+z") -> Mesh:
@@ -154,62 +206,21 @@ def plate_with_ellipse(lx: float, ly: float, center, semi_axes, front_size: floa
     c = np.asarray(center, float)[:2]
     o = np.asarray(origin, float)
     box = np.array([[o[0], o[1]], [o[0] + lx, o[1] + ly]])
-    clear = np.array([c[0] - a - box[0, 0], box[1, 0] - c[0] - a, c[1] - b - box[0, 1], box[1, 1] - c[1] - b])
-    if min(a, b, front_size, ring_width) <= 0 or ring_layers < 1 or (outer_layers is not None and outer_layers < 1):
-        raise MeshError("semi-axes, front_size, ring_width must be positive and ring_layers, outer_layers at least 1")
-    if clear.min() <= 0:
-        raise MeshError(f"the ellipse leaves the plate (its distance to the edges xmin, xmax, ymin, ymax is "
-                        f"{', '.join(f'{v:.6g}' for v in clear)}); move the centre or shrink the semi-axes")
-    if clear.min() <= ring_width:
-        raise MeshError(f"the ring of width {ring_width:.6g} reaches an edge (the ellipse is {clear.min():.6g} from "
-                        f"the nearest edge); give ring_width below {clear.min():.6g}")
-    t, m1, m2 = front_parameters(a, b, front_size)
-    n2 = t.size  # 2N front positions
-    direction = np.stack([np.cos(t), np.sin(t)], -1)
-    front = c + np.stack([a * np.cos(t), b * np.sin(t)], -1)
-    ring_out = front + ring_width * direction
-    # inside: core rectangle, then an O-ring of square-ish elements up to the front
-    core_uv, core_idx, loop = _core(m1, m2)
-    n_inner = max(1, int(round((1 - CORE_FRACTION) * min(a, b) / front_size)))
-    core_xy = c + core_uv * np.array([a, b])
-    # outside: ring (uniform layers), then the transition to the plate edges
-    side = _side_points(c, box, t, a + ring_width, b + ring_width)
-    reach = np.linalg.norm(side - ring_out, axis=1)  # length of each radial line of the transition
-    layer = ring_width / ring_layers
-    if outer_layers is None:  # enough layers to grow from a ring layer to the farthest corner
-        outer_layers = max(1, int(np.ceil(np.log1p((OUTER_GROWTH - 1) * reach.max() / layer) / np.log(OUTER_GROWTH))))
-    r_in = np.linspace(0.0, 1.0, 2 * n_inner + 1)[1:]
-    r_ring = np.linspace(0.0, 1.0, 2 * ring_layers + 1)[1:]
-    r_out = _geometric(outer_layers, layer / np.median(reach))[1:]
-    loop_xy = core_xy[loop]
-    rows = ([(1 - r) * loop_xy + r * front for r in r_in] + [front + r * ring_width * direction for r in r_ring]
-            + [(1 - r) * ring_out + r * side for r in r_out])
-    rows[2 * n_inner - 1] = front  # exactly on the ellipse
-    n_core = len(core_xy)
-    ids = np.vstack([loop[None], n_core + np.arange(len(rows) * n2).reshape(len(rows), n2)])
+    _check_fits(a, b, c, box, front_size, ring_width, ring_layers, outer_layers)
+    core_xy, core_idx, loop, rows, n_inner, outer_layers = _rows(c, box, a, b, front_size, ring_width, ring_layers,
+                                                                 outer_layers)
+    n2 = loop.size  # 2N positions around
+    ids = np.vstack([loop[None], len(core_xy) + np.arange(len(rows) * n2).reshape(len(rows), n2)])
     xy = np.vstack([core_xy] + rows)
-    wrap = np.hstack([ids, ids[:, :1]])
+    wrap = np.hstack([ids, ids[:, :1]])  # the O-grid closes on itself
     ring_start, out_start = 2 * n_inner, 2 * (n_inner + ring_layers)
-    core_el = _quads(core_idx)
-    inner_el = _quads(wrap[:ring_start + 1])
-    ring_el = _quads(wrap[ring_start:out_start + 1])
-    outer_el = _quads(wrap[out_start:])
-    elements = np.vstack([core_el, inner_el, ring_el, outer_el])
+    parts = [_quads(core_idx), _quads(wrap[:ring_start + 1]), _quads(wrap[ring_start:out_start + 1]),
+             _quads(wrap[out_start:])]
+    elements = np.vstack(parts).astype(np.int64)
     nodes = np.column_stack([xy, np.full(len(xy), o[2])])
-    n_in, n_ring = len(core_el) + len(inner_el), len(ring_el)
-    edge = ids[-1]
-    tol = 1e-9 * max(lx, ly)
-    node_sets = {"front": ids[ring_start], "inside": np.unique(elements[:n_in]),
-                 "interior": np.setdiff1d(elements[:n_in], ids[ring_start]),
-                 "xmin": edge[np.abs(nodes[edge, 0] - box[0, 0]) <= tol],
-                 "xmax": edge[np.abs(nodes[edge, 0] - box[1, 0]) <= tol],
-                 "ymin": edge[np.abs(nodes[edge, 1] - box[0, 1]) <= tol],
-                 "ymax": edge[np.abs(nodes[edge, 1] - box[1, 1]) <= tol]}
-    for k in ("xmin", "xmax", "ymin", "ymax"):
-        node_sets[k] = np.sort(node_sets[k])
-    element_sets = {"inside": np.arange(n_in), "ring": n_in + np.arange(n_ring),
-                    "outer": n_in + n_ring + np.arange(len(outer_el)), "outside": n_in + np.arange(n_ring + len(outer_el))}
-    mesh = Mesh(nodes, elements.astype(np.int64), node_sets, element_sets)
+    counts = (len(parts[0]) + len(parts[1]), len(parts[2]), len(parts[3]))
+    node_sets, element_sets = _sets(nodes, elements, ids[ring_start], ids[-1], counts, box, 1e-9 * max(lx, ly))
+    mesh = Mesh(nodes, elements, node_sets, element_sets)
     sign = -1.0 if normal.strip().startswith("-") else 1.0
     mesh = _orient(mesh, lambda cc: np.tile([0.0, 0.0, sign], (len(cc), 1)))
     try:
