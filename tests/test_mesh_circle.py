@@ -360,6 +360,9 @@ def test_good_circle_mesh_is_accepted(tmp_path):
     ("both", {"semi_axes": [0.3, 0.2]}, ("radius", "semi_axes", "not both")),
     ("neither", {"radius": None}, ("radius", "semi_axes", "not both or neither")),
     ("infinite", {"lx": float("inf")}, ("lx must be a finite number",)),
+    ("too_coarse", {"front_size": 0.3}, ("front_size", "too few elements", "smaller front_size")),
+    ("folds", {"radius": 0.45, "ring_width": 0.0499}, ("64 element(s) would fold", "in the outer",
+                                                        "move the centre towards the middle")),
 ])
 def test_bad_circle_mesh_is_one_clear_paragraph(tmp_path, name, keys, fields):
     o = _outcome(tmp_path, name, Case("cantilever_thick.toml", _circle_mesh(**keys), inprocess=True))

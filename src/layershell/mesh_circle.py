@@ -225,8 +225,16 @@ def plate_with_ellipse(lx: float, ly: float, center, semi_axes, front_size: floa
     mesh = _orient(mesh, lambda cc: np.tile([0.0, 0.0, sign], (len(cc), 1)))
     try:
         mesh.check()
-    except MeshError as exc:
-        raise MeshError(f"the ellipse sits too close to the plate edges or corners for the transition to the edges "
-                        f"({exc}); move the centre towards the middle, shrink the semi-axes or the ring_width, or "
-                        "give a smaller front_size") from None
+    except MeshError:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            jg, _ = mesh.jacobians()
+            ratio = jg.min(1) / np.abs(jg).max(1)
+        bad = np.flatnonzero(~(ratio >= Mesh.MIN_JACOBIAN_RATIO))
+        where = ", ".join(f"{np.isin(bad, v).sum()} in the {k}" for k, v in element_sets.items()
+                          if k != "outside" and np.isin(bad, v).any())
+        raise MeshError(f"{bad.size} element(s) would fold or be badly distorted ({where}; the smallest signed "
+                        f"Jacobian over the largest is {ratio[bad].min():.3g}, at least {Mesh.MIN_JACOBIAN_RATIO} is "
+                        "needed): the ellipse or its ring sits too close to a plate edge or corner, or the front has "
+                        "too few elements; move the centre towards the middle, shrink the semi-axes or ring_width, "
+                        "or give a smaller front_size") from None
     return mesh
