@@ -28,6 +28,12 @@ SECTIONS = [
      "'direction')."),
     ("segments = [{...}] (revolution mesh)", schema.MeridianSegment,
      "One piece of the meridian between consecutive meridian points."),
+    ("[mesh] type = \"plate_with_circle\"", schema.PlateWithCircleMesh,
+     "Flat rectangular plate in the x-y plane with a circular or elliptical front (e.g. of a delamination) "
+     "along element edges: nodes on the ellipse, a refined ring outside it, a butterfly grid inside and a "
+     "transition to the plate edges. Element sets: inside, ring, outer, outside (ring and outer). Node sets: "
+     "front, inside (front included), interior (strictly inside the front), xmin, xmax, ymin, ymax. A layer without 'direction' takes material axis 1 "
+     "along global x on this mesh."),
     ("[mesh] type = \"file\"", schema.FileMesh, "A 9-node quadrilateral mesh read with meshio."),
     ("[materials.NAME] type = \"isotropic\"", schema.Isotropic, "Isotropic linear elastic material."),
     ("[materials.NAME] type = \"orthotropic\"", schema.OrthotropicMat,

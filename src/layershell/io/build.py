@@ -413,6 +413,11 @@ def _mesh_size(md) -> tuple[int, str] | None:
         segs = getattr(md, "segments", None)
         n_mer = md.n_meridian if md.n_meridian is not None else sum(s.elements for s in (segs or []))
         return n_mer * md.n_circ, "(elements along the meridian) × n_circ"
+    if md.type == "plate_with_circle":
+        a, b = (md.radius, md.radius) if md.radius is not None else md.semi_axes
+        around = min(math.pi * (a + b) / md.front_size, 1e12)  # elements along the front, about
+        count = around * (around / 8 + md.ring_layers + (md.outer_layers or 10))
+        return int(min(count, 1e18)), "(elements along the front) × (layers across the plate)"
     return None
 
 
@@ -434,6 +439,15 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
             for sg in md.segments]
         return meshmod.revolution(md.meridian_r, md.meridian_z, md.n_meridian, md.n_circ, md.angle, md.normal,
                                   segments=segs, thickness=md.meridian_thickness)
+    if md.type == "plate_with_circle":
+        from ..mesh_circle import plate_with_ellipse
+        axes = (md.radius, md.radius) if md.radius is not None else md.semi_axes
+        key = "radius" if md.radius is not None else "semi_axes"
+        try:
+            return plate_with_ellipse(md.lx, md.ly, md.center, axes, md.front_size, md.ring_width, md.ring_layers,
+                                      md.outer_layers, md.origin, md.normal)
+        except meshmod.MeshError as exc:
+            raise InputError(f"'mesh' (plate_with_circle: center, {key}, front_size, ring_width): {exc}") from None
     path = base / md.path
     if not path.is_file():
         raise InputError(f"'mesh.path': the mesh file '{md.path}' does not exist (looked for {path}); "
@@ -870,10 +884,12 @@ def _check_slender(model: Model) -> None:
                          "mesh (e.g. mm against m, or the mesh file's 'scale')")
 
 
-def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray) -> Layer:
+def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray, mesh_type: str) -> Layer:
     """The model's layer of ``ld`` (materials ``mats``, nodal thickness ``th``); a ply stack takes
     its homogenised equivalent as the layer material (estimates only, :class:`Layer`)."""
     direction = tuple(ld.direction) if ld.direction is not None else None
+    if direction is None and mesh_type == "plate_with_circle":
+        direction = (1.0, 0.0, 0.0)  # its elements' first coordinate lines turn around the front
     if ld.plies is None:
         return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction)
     total = sum(p.thickness for p in ld.plies)
@@ -917,7 +933,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              "computed in floating point; check the units of the thickness and of the mesh")
         if ld.direction is not None:
             _vec(ld.direction, f"layers[{i}].direction")
-        layers.append(_layer(ld, mats, th))
+        layers.append(_layer(ld, mats, th, mf.mesh.type))
 
     def layer_idx(name, field):
         if name is None:

@@ -218,13 +218,63 @@ class RevolutionMesh(MeshBase):
         return self
 
 
+class PlateWithCircleMesh(MeshBase):
+    type: Literal["plate_with_circle"]
+    lx: PositiveFloat = Field(description="length along x (length)")
+    ly: PositiveFloat = Field(description="length along y (length)")
+    origin: Vec3 = Field([0.0, 0.0, 0.0], description="[x, y, z] of the corner with the smallest x and y (length)")
+    normal: Literal["+z", "-z"] = Field("+z", description="'+z': reference face at the bottom; '-z': on top")
+    center: Annotated[list[float], Field(min_length=2, max_length=2)] = Field(description=(
+        "[x, y] of the circle's (ellipse's) centre (length, absolute coordinates, origin included)"))
+    radius: PositiveFloat | None = Field(None, description="radius of the circle (length); or semi_axes")
+    semi_axes: Annotated[list[PositiveFloat], Field(min_length=2, max_length=2)] | None = Field(None, description=(
+        "[a, b]: semi-axes of an ellipse along x and y (length); or radius"))
+    front_size: PositiveFloat = Field(description=(
+        "element length along the front (corner to corner, nodes every front_size / 2): each quarter of the "
+        "ellipse gets the fewest equal elements no longer than this"))
+    ring_width: PositiveFloat = Field(description=(
+        "width of the refined ring of elements outside the front (length): it ends on the ellipse with the "
+        "semi-axes enlarged by ring_width"))
+    ring_layers: PositiveInt = Field(description="element layers across the ring (equal)")
+    outer_layers: PositiveInt | None = Field(None, description=(
+        "element layers from the ring to the plate edges, growing geometrically from about a ring layer's "
+        "thickness (default: as many as a growth of 1.3 per layer needs)"))
+
+    @model_validator(mode="after")
+    def _fits(self):
+        if (self.radius is None) == (self.semi_axes is None):
+            raise ValueError("give either radius (a circle) or semi_axes = [a, b] (an ellipse), not both or neither")
+        sizes = {"lx": self.lx, "ly": self.ly, "radius": self.radius, "front_size": self.front_size,
+                 "ring_width": self.ring_width, "semi_axes": max(self.semi_axes or [0.0])}
+        for name, v in sizes.items():
+            if v is not None and not math.isfinite(v):
+                raise ValueError(f"{name} must be a finite number (got {v}); give a length in the model's units")
+        a, b = (self.radius, self.radius) if self.radius is not None else self.semi_axes
+        x0, y0 = self.origin[0], self.origin[1]
+        cx, cy = self.center
+        key = "radius" if self.radius is not None else "semi_axes"
+        gaps = {"xmin": cx - a - x0, "xmax": x0 + self.lx - cx - a, "ymin": cy - b - y0, "ymax": y0 + self.ly - cy - b}
+        edge, gap = min(gaps.items(), key=lambda kv: kv[1])
+        if not all(math.isfinite(v) for v in (cx, cy)) or gap <= 0:
+            raise ValueError(f"the {'circle' if key == 'radius' else 'ellipse'} (center = [{cx:.6g}, {cy:.6g}], "
+                             f"{key} = {self.radius if key == 'radius' else self.semi_axes}) leaves the plate "
+                             f"x from {x0:.6g} to {x0 + self.lx:.6g}, y from {y0:.6g} to {y0 + self.ly:.6g} "
+                             f"(past the {edge} edge by {-gap:.6g}); move center or reduce {key} so that it lies "
+                             "inside, with room for the ring")
+        if self.ring_width >= gap:
+            raise ValueError(f"ring_width = {self.ring_width:.6g} is wider than the space between the front and the "
+                             f"{edge} edge ({gap:.6g}); give ring_width below {gap:.6g} (e.g. {0.5 * gap:.3g}), "
+                             f"leaving room for the transition to the edges")
+        return self
+
+
 class FileMesh(MeshBase):
     type: Literal["file"]
     path: str = Field(description="mesh file read with meshio (Gmsh .msh, .vtu, ...), relative to the model file")
     scale: PositiveFloat = Field(1.0, description="factor on the file's coordinates (e.g. 0.001: mm → m)")
 
 
-Mesh = Annotated[Union[RectangleMesh, CylinderMesh, RevolutionMesh, FileMesh], Field(discriminator="type")]
+Mesh = Annotated[Union[RectangleMesh, CylinderMesh, RevolutionMesh, PlateWithCircleMesh, FileMesh], Field(discriminator="type")]
 
 
 # ------------------------------------------------------------------ materials and layers
