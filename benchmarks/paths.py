@@ -94,10 +94,13 @@ def _deviation(values, refs) -> tuple[float, float]:
 
 
 def _peak_and_branch(P, ref, grow) -> dict:
-    """The peak of P against ``ref`` there, and the range of P/ref - 1 over the states ``grow``."""
+    """The peak of P against ``ref`` there (none where no later state lies below it: a run capped
+    or stopped on its way up), and the range of P/ref - 1 over the states ``grow``."""
     import numpy as np
 
     k = int(np.argmax(P))
+    if not np.any(P[k + 1:] < P[k]):
+        return {"peak": math.nan, "peak_reference": float(ref[k]), "branch_deviation": (math.nan, math.nan)}
     return {"peak": float(P[k]), "peak_reference": float(ref[k]), "branch_deviation": _deviation(P[grow], ref[grow])}
 
 
@@ -135,7 +138,8 @@ def mmb_reference(s: dict) -> dict:
     ref = np.array([T.mmb_load_factor(x) if np.isfinite(x) else math.nan for x in a])
     k = int(np.argmax(np.where(np.isfinite(a), lam, -np.inf)))
     grow = (np.arange(lam.size) > k) & np.isfinite(a) & (a < 48.5)
-    return {"peak": float(lam[k]), "peak_reference": float(ref[k]),
+    passed = bool(np.any(lam[k + 1:] < lam[k]))
+    return {"peak": float(lam[k]) if passed else math.nan, "peak_reference": float(ref[k]),
             "branch_deviation": _deviation(lam[grow], ref[grow]),
             "reference": "Reeder & Crews beam theory, Benzeggagh-Kenane G_c (load factor)"}
 
@@ -149,7 +153,9 @@ def lapshear_reference(s: dict) -> dict:
 
 
 def plate_reference(s: dict) -> dict:
-    w = s["probes"]["w_front_max"] if s.get("probes") else math.nan
+    """w_front_max at λ = 1 (none where the run did not get there)."""
+    at_end = s.get("probes") and s["steps"][-1]["load_factor"] == 1.0
+    w = s["probes"]["w_front_max"] if at_end else math.nan
     return {"peak": w, "peak_reference": 0.0596738, "branch_deviation": (math.nan, math.nan),
             "reference": "w_front_max at lambda = 1 of the 24 x 24 run (m, docs/performance.md)"}
 
@@ -159,9 +165,14 @@ def slab_reference(first: float, second: float) -> Callable[[dict], dict]:
     load-controlled limit, the second peak (largest λ with more than 1 m² debonded) against the
     measured one; 'peak' is the second where the run got there."""
     def ref(s: dict) -> dict:
+        import numpy as np
+
         lam = _series(s, lambda st: st["load_factor"])
         area = _series(s, lambda st: sum(st.get("debonded_area", {}).values()))
-        first_fe = max((l for l, a in zip(lam, area) if a < 0.3), default=math.nan)
+        intact = [i for i, a in enumerate(area) if a < 0.3]
+        top = max(intact, key=lambda i: lam[i], default=None)
+        passed = top is not None and bool(np.any(lam[top + 1:] < lam[top]))  # the end-debonding peak passed
+        first_fe = lam[top] if passed else math.nan
         later = [l for l, a in zip(lam, area) if a > 1.0]
         second_fe = max(later) if later else math.nan
         return {"peak": second_fe, "peak_reference": second,
@@ -286,7 +297,8 @@ def _stopped_at(s: dict, result, interrupted: bool) -> str:
         return f"lambda = {lam:.6g} (capped)"
     if s.get("converged"):
         return f"lambda = {lam:.6g} ({s.get('path_end') or 'last step'})"
-    return f"lambda = {lam:.6g}: {(result.message or 'stopped').splitlines()[0][:120]}"
+    reason = (result.message or "stopped").splitlines()[0]
+    return f"lambda = {lam:.6g}: " + (reason if len(reason) <= 100 else reason[:99] + "…")
 
 
 def measure(name: str, max_seconds: float | None) -> dict:

@@ -126,3 +126,20 @@ def test_table_writer_produces_the_columns(tmp_path):
 def test_unknown_case_is_named(capsys):
     with pytest.raises(SystemExit, match="unknown case.*enf_100"):
         paths.main(["--case", "nope"])
+
+
+def test_a_path_that_has_not_passed_its_peak_reports_none():
+    """A run capped on its way up reports no peak (its last state is no peak) and no branch; the
+    slab's end-debonding peak counts once a later state lies below it, the plate's deflection
+    only at λ = 1."""
+    rising = {"steps": [{"load_factor": l, "probes": {"P": 10 * l, "w_upper": l, "w_lower": -l},
+                         "debonded_area": {"i": 0.0}} for l in (0.1, 0.2, 0.3)]}
+    ref = paths.dcb_reference(paths.EXAMPLE_DCB)(rising)
+    assert math.isnan(ref["peak"]) and all(map(math.isnan, ref["branch_deviation"]))
+    slab = paths.slab_reference(327.13, 376.6)
+    assert all(map(math.isnan, slab(rising)["branch_deviation"]))
+    passed = {"steps": rising["steps"] + [{"load_factor": 0.25, "debonded_area": {"i": 0.1}}]}
+    assert slab(passed)["branch_deviation"][0] == pytest.approx(0.3 / 327.13 - 1)
+    assert math.isnan(paths.plate_reference({**rising, "probes": {"w_front_max": 0.01}})["peak"])
+    at_end = {"steps": [{"load_factor": 1.0}], "probes": {"w_front_max": 0.0597}}
+    assert paths.plate_reference(at_end)["peak"] == 0.0597
