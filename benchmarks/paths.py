@@ -377,7 +377,7 @@ def _fmt(key: str, v) -> str:
         return f"{100 * v:+.2f} %" if key == "peak_deviation" else f"{100 * v:.2f} %"
     if key == "branch_deviation":
         lo, hi = v
-        return "-" if math.isnan(lo) else f"{100 * lo:+.1f} ... {100 * hi:+.1f} %"
+        return "-" if lo is None or math.isnan(lo) else f"{100 * lo:+.1f} ... {100 * hi:+.1f} %"
     if key in ("peak", "peak_reference"):
         return f"{v:.6g}"
     return str(v)

@@ -121,6 +121,9 @@ def test_table_writer_produces_the_columns(tmp_path):
     assert set(data) == set(paths.COLUMNS)
     assert data["peak_deviation"] == pytest.approx(0.05) and data["branch_deviation"] == [-0.008, 0.017]
     assert json.loads(paths.json_text([{**FAKE, "energy_balance": math.nan}]))[0]["energy_balance"] is None
+    # the JSON rows give the same Markdown table again (no branch: NaN written as null)
+    rows = [FAKE, {**FAKE, "case": "lapshear_friction", "branch_deviation": (math.nan, math.nan)}]
+    assert paths.markdown(json.loads(paths.json_text(rows))) == paths.markdown(rows)
 
 
 def test_unknown_case_is_named(capsys):
