@@ -28,15 +28,6 @@ def _bonded_groups(model: Model) -> np.ndarray:
     return group
 
 
-def _present(model: Model) -> np.ndarray:
-    """(n_layers, n_nodes): layer k exists at the node (an element of a stack with k touches it)."""
-    on = np.zeros((len(model.layers), model.mesh.n_nodes), bool)
-    for si, st in enumerate(model.stacks):
-        nodes = np.unique(model.mesh.elements[model.element_stack == si])
-        on[np.ix_(list(st), nodes)] = True
-    return on
-
-
 def _normals(model: Model) -> np.ndarray:
     """(n_nodes, 3) unit normals of the reference surface at the nodes."""
     from .io.build import nodal_normals
@@ -103,7 +94,7 @@ def unheld_layer_warnings(spec) -> list[str]:
     if not model.interface_laws:
         return []
     group = _bonded_groups(model)
-    present = _present(model)
+    present = model.layers_present()
     held = np.zeros_like(present)
     supports = [*model.fixes, *model.ties]
     for c in supports:

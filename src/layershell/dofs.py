@@ -31,11 +31,7 @@ class DofMap:
 def number_dofs(model: Model) -> DofMap:
     n_nodes = model.mesh.n_nodes
     nl = len(model.layers)
-    present = np.zeros((nl, n_nodes), bool)
-    for si, st in enumerate(model.stacks):
-        nodes = np.unique(model.mesh.elements[model.element_stack == si])
-        for k in st:
-            present[k, nodes] = True
+    present = model.layers_present()
     size = np.array([3 * (ly.directors + 1) for ly in model.layers])
     per_node = (present * size[:, None]).sum(0)
     start = np.concatenate([[0], np.cumsum(per_node)[:-1]])

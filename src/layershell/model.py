@@ -177,6 +177,14 @@ class Model:
                     )
         return out
 
+    def layers_present(self) -> np.ndarray:
+        """(n_layers, n_nodes): layer k exists at the node (an element of a stack with k touches it)."""
+        on = np.zeros((len(self.layers), self.mesh.n_nodes), bool)
+        for si, st in enumerate(self.stacks):
+            nodes = np.unique(self.mesh.elements[self.element_stack == si])
+            on[np.ix_(list(st), nodes)] = True
+        return on
+
     def offset(self, layer: int) -> np.ndarray:
         """Nodal Θ_1³ of the bottom face of ``layer`` (sum of the thicknesses below it)."""
         b = self.below()

@@ -560,12 +560,7 @@ def _heights(model: Model, nodes: np.ndarray, height: float | None, face: str | 
     per layer (the layer containing the height; the upper one at an interface)."""
     layers = model.layers
     tol = 1e-9 * model.mesh.size()
-    present = np.zeros((len(layers), nodes.size), bool)
-    for si, st in enumerate(model.stacks):
-        on = np.zeros(model.mesh.n_nodes, bool)
-        on[np.unique(model.mesh.elements[model.element_stack == si])] = True
-        for k in st:
-            present[k] |= on[nodes]
+    present = model.layers_present()[:, nodes]
     if face is not None:
         if face == "reference":
             h = np.zeros(nodes.size)
@@ -610,11 +605,7 @@ def _downward_face_note(m: meshmod.Mesh, nodes: np.ndarray, face: str, f: str) -
 
 def _present_at(model: Model, k: int, nodes: np.ndarray) -> np.ndarray:
     """Whether layer ``k`` exists at each node (an element of a stack with that layer touches it)."""
-    on = np.zeros(model.mesh.n_nodes, bool)
-    for si, st in enumerate(model.stacks):
-        if k in st:
-            on[np.unique(model.mesh.elements[model.element_stack == si])] = True
-    return on[nodes]
+    return model.layers_present()[k, nodes]
 
 
 def _default_layer(model: Model, nodes: np.ndarray, first: int) -> int:
