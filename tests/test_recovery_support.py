@@ -68,3 +68,11 @@ def test_end_block_statics_next_to_bearing(h):
     side = stresses(spec, res, np.full(zq.size, X - 1e-7), zq)[:, 0, 2] @ (wg * DEPTH / 4)
     # measured: +0.19, +0.25, +0.29, +0.31 % of R (the raw values alone: -0.01 %)
     assert abs(top + side + R) < 0.01 * R, (top, side, R)
+
+
+def test_the_warning_names_the_place_of_a_single_element():
+    """The place of the raw zone is named for one element too (every coordinate equal)."""
+    from layershell.recovery import _span_text
+
+    assert _span_text(np.array([[1.0, 0.5, 0.0]])) == "x = 1, y = 0.5, z = 0"
+    assert _span_text(np.array([[0.0, 0.5, 0.0], [2.0, 0.5, 0.0]])) == "x 0 to 2, y = 0.5, z = 0"

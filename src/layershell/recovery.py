@@ -446,9 +446,9 @@ class RecoveryWarning(UserWarning):
 
 
 def _span_text(X: np.ndarray) -> str:
-    names = "xyz"
-    return ", ".join(f"{names[i]} {X[:, i].min():.6g} to {X[:, i].max():.6g}" for i in range(3)
-                     if X[:, i].max() > X[:, i].min())
+    """Where points ``X (n, 3)`` lie: 'x 0 to 1, y = 0.5, z = 0' (a range where they differ)."""
+    lo, hi = X.min(axis=0), X.max(axis=0)
+    return ", ".join(f"{n} {a:.6g} to {b:.6g}" if b > a else f"{n} = {a:.6g}" for n, a, b in zip("xyz", lo, hi))
 
 
 def raw_fallback_warning(model: Model, probes=(), profiles=(), vtu: bool = False,
