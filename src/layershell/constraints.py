@@ -265,14 +265,9 @@ def _resolve_chain(S: sp.csr_matrix, D: sp.csr_matrix) -> sp.csr_matrix:
 
 
 def _resolve_vector(gp: np.ndarray, D: sp.csr_matrix) -> np.ndarray:
-    """g = g_p + D g: prescribed values carried to the DOFs that depend on them."""
-    g = gp.copy()
-    for _ in range(64):
-        gn = gp + D @ g
-        if np.allclose(gn, g, rtol=0.0, atol=1e-14 * max(1.0, np.abs(gn).max())):
-            return gn
-        g = gn
-    raise ConstraintError("constraints refer to each other in a cycle; check supports, hinges and bonds")
+    """g = g_p + D g: prescribed values carried to the DOFs that depend on them (the substitution
+    of :func:`_resolve_chain` on one column)."""
+    return _resolve_chain(sp.csr_matrix(gp[:, None]), D).toarray().ravel()
 
 
 def _prescribed_values(n_full: int, rows: _Rows) -> tuple[np.ndarray, np.ndarray]:
@@ -298,7 +293,7 @@ def _without_zero_vectors(op: ConstraintOperator) -> ConstraintOperator:
     if g_s is None and g_c is None:
         pres = None
     elif pres is None:
-        pres = np.flatnonzero((g_s if g_s is not None else 0.0) + np.abs(g_c if g_c is not None else 0.0))
+        pres = np.flatnonzero(np.abs(g_s if g_s is not None else 0.0) + np.abs(g_c if g_c is not None else 0.0))
     return ConstraintOperator(op.T, op.independent, op.fixed, g_s, g_c, pres)
 
 

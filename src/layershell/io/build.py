@@ -603,30 +603,27 @@ def _downward_face_note(m: meshmod.Mesh, nodes: np.ndarray, face: str, f: str) -
             f"the other side write face = '{other}'"]
 
 
-def _present_at(model: Model, k: int, nodes: np.ndarray) -> np.ndarray:
-    """Whether layer ``k`` exists at each node (an element of a stack with that layer touches it)."""
-    return model.layers_present()[k, nodes]
-
-
 def _default_layer(model: Model, nodes: np.ndarray, first: int) -> int:
     """The layer a support without 'layer' holds: the first stack's bottom layer where it exists at
     every selected node, else the lowest layer that does (the layer at the reference face there)."""
-    if _present_at(model, first, nodes).all():
+    present = model.layers_present()[:, nodes].all(axis=1)
+    if present[first]:
         return first
-    here = [j for j in range(len(model.layers)) if _present_at(model, j, nodes).all()]
-    return min(here, key=lambda j: model.offset(j)[nodes].mean()) if here else first
+    here = np.flatnonzero(present)
+    return int(min(here, key=lambda j: model.offset(j)[nodes].mean())) if here.size else first
 
 
 def _require_present(model: Model, k: int, nodes: np.ndarray, f: str) -> None:
     """A support on layer ``k`` must select nodes where that layer exists: elsewhere it would
     hold nothing."""
-    here = _present_at(model, k, nodes)
-    if here.all():
+    present = model.layers_present()[:, nodes]
+    if present[k].all():
         return
     name = model.layers[k].name
-    bad = nodes[~here]
+    first_bad = int(np.flatnonzero(~present[k])[0])
+    bad = nodes[~present[k]]
     x = model.mesh.nodes[bad[0]]
-    there = [model.layers[j].name for j in range(len(model.layers)) if _present_at(model, j, bad[:1])[0]]
+    there = [model.layers[j].name for j in np.flatnonzero(present[:, first_bad])]
     raise InputError(
         f"'{f}': layer '{name}' does not exist at {bad.size} of the {nodes.size} selected node(s) (first at "
         f"({x[0]:g}, {x[1]:g}, {x[2]:g}); '[[stacks]]' leaves it out there), so the support would hold nothing "
@@ -676,8 +673,9 @@ def _ties(model: Model, sd, nodes: np.ndarray, f: str, index: dict, first: int) 
     if sd.height is not None:
         h = float(sd.height)
         if k is None:  # the layer containing the height at the nodes (the upper one at an interface)
+            present = model.layers_present()[:, nodes].all(axis=1)
             cands = [j for j in range(len(layers))
-                     if _present_at(model, j, nodes).all()
+                     if present[j]
                      and np.all((model.offset(j)[nodes] <= h + 1e-9 * model.mesh.size())
                                & (h <= (model.offset(j) + layers[j].thickness)[nodes] + 1e-9 * model.mesh.size()))]
             if not cands:
