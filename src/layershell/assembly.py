@@ -44,6 +44,16 @@ def build_blocks(model: Model, dm: DofMap, elements: np.ndarray | None = None) -
         X = mesh.nodes[conn]
         for k in stack:
             ly = model.layers[k]
+            if ly.inelastic:
+                from .element.inelastic import inelastic_block
+
+                sheets = tuple((r.name, r.law, r.height, r.area, r.angle, r.direction)
+                               for r in ly.reinforcement)
+                ref = inelastic_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
+                                      ly.law, sheets, max(model.n_thickness, ly.directors),
+                                      getattr(model, "element", "mitc"), ly.angle, ly.direction)
+                blocks.append(Block(k, el, dm.element_dofs(model, k, el), ref))
+                continue
             ref = layer_block(X, model.offset(k)[conn], ly.thickness[conn], ly.directors, ly.material,
                               ly.angle, ly.direction, max(model.n_thickness, ly.directors),
                               element=getattr(model, "element", "mitc"), plies=ly.ply_table() if ly.plies else None)
@@ -369,7 +379,38 @@ class Assembler:
         self.blocks = build_blocks(model, dm)
         self.extra: list = []
         self._bulk: _LinearBulk | None = None
+        # inelastic layers (element/inelastic.py): the committed point states per block index, and
+        # the trial states of the last evaluation
+        from .element.inelastic import InelasticBlock, initial_state
+
+        self.committed = {i: initial_state(b.ref) for i, b in enumerate(self.blocks) if isinstance(b.ref, InelasticBlock)}
+        self.trial = {i: st.copy() for i, st in self.committed.items()}
         self._pattern()
+
+    @property
+    def inelastic(self) -> bool:
+        """Some layer has a material history (its response depends on the committed state)."""
+        return bool(self.committed)
+
+    def commit(self, u_full: np.ndarray) -> None:
+        """Take the material state at ``u_full`` (a converged solution) as the committed one."""
+        if not self.committed:
+            return
+        self._layers(u_full, np.zeros(self.dm.n_full), None)
+        self.committed = {i: st.copy() for i, st in self.trial.items()}
+
+    def material_state(self) -> dict[str, np.ndarray]:
+        """The committed point states as plain arrays (snapshots, checkpoints)."""
+        out: dict[str, np.ndarray] = {}
+        for i, st in self.committed.items():
+            out.update(st.to_dict(f"block{i}"))
+        return out
+
+    def set_material_state(self, arrays: dict) -> None:
+        """Restore the committed point states from :meth:`material_state`'s arrays (KeyError if one
+        is missing or of another shape)."""
+        self.committed = {i: st.load(arrays, f"block{i}") for i, st in self.committed.items()}
+        self.trial = {i: st.copy() for i, st in self.committed.items()}
 
     def add_blocks(self, extra: list) -> None:
         """Add element-like blocks with ``.dofs (e, m)`` and ``.response(u) -> (f, K)`` (contact)
@@ -437,7 +478,7 @@ class Assembler:
         the extra blocks (cohesive interfaces, contact) to it (re-forming the same element
         tangents would take most of an iteration of the DCB, ENF and lap-shear models); the
         internal forces still come from the kernel (:meth:`_layer_forces`)."""
-        if self.model.nonlinear or _jit() is None or not self.blocks or not self.extra:
+        if self.model.nonlinear or _jit() is None or not self.blocks or not self.extra or self.committed:
             return None  # (without extra blocks Newton takes one or two iterations a step: no cache, no memory)
         if self._bulk is None:
             data = np.zeros(self.nnz)
@@ -467,11 +508,18 @@ class Assembler:
         n = self.dm.n_full
         jit_mod = _jit()
         pos = 0
-        for b in self.blocks:
+        for bi, b in enumerate(self.blocks):
             U = u_full[b.dofs].reshape(b.dofs.shape[0], -1, 3)
             for s in range(0, b.dofs.shape[0], self.chunk):
                 sl = slice(s, s + self.chunk)
-                fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl)
+                if bi in self.committed:
+                    from .element.inelastic import inelastic_response, put_trial
+
+                    fe, Ke, tr = inelastic_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl,
+                                                    self.committed[bi])
+                    put_trial(self.trial[bi], b.ref, sl, tr)
+                else:
+                    fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl)
                 if f is not None:
                     f += np.bincount(b.dofs[sl].ravel(), weights=fe.ravel(), minlength=n)
                 if data is None:
@@ -590,4 +638,5 @@ class Assembler:
         """Every contribution to K is symmetric: the element tangents are (Bᵀ C B and the
         geometric term), extra blocks declare it (``symmetric = True``, or ``symmetric_now`` for
         the tangent they gave last)."""
-        return all(getattr(b, "symmetric", False) or getattr(b, "symmetric_now", False) for b in self.extra)
+        return (all(getattr(b, "symmetric", False) or getattr(b, "symmetric_now", False) for b in self.extra)
+                and all(self.blocks[i].ref.symmetric for i in self.committed))

@@ -23,6 +23,21 @@ class Ply:
 
 
 @dataclass(frozen=True)
+class Reinforcement:
+    """A reinforcement sheet inside a layer (rebar, textile): a uniaxial ``law``
+    (:mod:`layershell.laws.uniaxial`) at ``height`` above the layer's bottom face, with the area
+    ``area`` per unit width along the tangent-plane projection of ``direction`` (None: the first
+    coordinate line) turned by ``angle`` degrees about the normal (:mod:`layershell.element.inelastic`)."""
+
+    name: str
+    law: object
+    height: float
+    area: float
+    angle: float = 0.0
+    direction: tuple[float, float, float] | None = None
+
+
+@dataclass(frozen=True)
 class Layer:
     """One layer: material, number of directors d (MODEL.md §2: u = Σ (Θ_L³)^l u_l, l=0..d),
     nodal thickness ``(n_nodes,)`` and material orientation (angle ω about the normal from the
@@ -41,6 +56,15 @@ class Layer:
     angle: float = 0.0
     direction: tuple[float, float, float] | None = None
     plies: tuple[Ply, ...] = ()
+    # an inelastic bulk law (:mod:`layershell.laws`; ``material`` is then its initial elastic
+    # stand-in) and reinforcement sheets inside the layer
+    law: object | None = None
+    reinforcement: tuple[Reinforcement, ...] = ()
+
+    @property
+    def inelastic(self) -> bool:
+        """The layer has a material law with a history or reinforcement sheets."""
+        return self.law is not None or bool(self.reinforcement)
 
     def ply_table(self) -> tuple[tuple[Orthotropic, float, float], ...]:
         """(material, angle ω in degrees, thickness fraction) per ply, bottom to top; a layer

@@ -124,6 +124,7 @@ def layer_block(
     n_inplane: int = 3,
     element: str = "full",
     plies=None,
+    keep_map: bool = False,
 ):
     """Precompute one layer for elements with nodal coordinates ``X (e, 9, 3)``.
 
@@ -134,14 +135,16 @@ def layer_block(
     with fewer the (Θ_L)^d director of d ≥ 3 has zero-energy modes once the shear is tied).
     ``plies``: (material, angle, thickness fraction) per ply, bottom to top, instead of
     ``material`` and ``angle_deg``: ``n_thickness`` Gauss points in each ply, C per point from
-    its ply (:meth:`layershell.model.Layer.ply_table`).
+    its ply (:meth:`layershell.model.Layer.ply_table`). ``keep_map``: the MITC9 block keeps the
+    map T from tied covariant to Cartesian strains (inelastic layers, :mod:`.inelastic`).
     """
     if element == "mitc":
         from .mitc import mitc_block
 
         if n_inplane != 3:
             raise ValueError("the MITC9 element needs the 3 x 3 in-plane rule")
-        return mitc_block(X, H_below, H, d, material, angle_deg, direction, max(n_thickness, d + 1), plies=plies)
+        return mitc_block(X, H_below, H, d, material, angle_deg, direction, max(n_thickness, d + 1), plies=plies,
+                          keep_map=keep_map)
     if element != "full":
         raise ValueError(f"element: unknown element {element!r} (use 'mitc' or 'full')")
     pts, w2 = gauss_2d(n_inplane)
@@ -212,20 +215,27 @@ def layer_response_reference(
     nonlinear: bool = True,
     tangent: bool = True,
     sl: slice = slice(None),
+    stress=None,
 ):
     """Plain NumPy form of :func:`layer_response` (Voigt B and C, (2.267)-(2.268) literally).
 
-    Kept as the independent second computation the fast kernel is tested against.
+    Kept as the independent second computation the fast kernel is tested against, and the form
+    of inelastic layers: ``stress(E) -> (S, D)`` gives the stress and the tangent dS/dE
+    (``(e, q, 6)``, ``(e, q, 6, 6)``, Cartesian Voigt) from the Green-Lagrange strain ``E (e, q,
+    6)`` at the block's points in place of S = C E (:mod:`.inelastic`).
     """
     if not isinstance(block, LayerBlock):  # MITC9 block
         from .mitc import mitc_response_reference
 
-        return mitc_response_reference(block, U, nonlinear, tangent, sl)
+        return mitc_response_reference(block, U, nonlinear, tangent, sl, stress)
     g, dV, C = block.gradphi[sl], block.dV[sl], block.C[sl]
     Hgrad = np.einsum("eai,eqaJ->eqiJ", U, g)
     F = _I3 + Hgrad if nonlinear else np.broadcast_to(_I3, Hgrad.shape)
     Ev = green_lagrange(Hgrad, nonlinear)
-    S = np.einsum("eqvw,eqw->eqv", C, Ev)
+    if stress is None:
+        S = np.einsum("eqvw,eqw->eqv", C, Ev)
+    else:
+        S, C = stress(Ev)
     B = strain_displacement(F, g)  # (e, a, i, q, 6)
     e, q, a = g.shape[:3]
     m = a * 3

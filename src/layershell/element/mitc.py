@@ -260,6 +260,7 @@ class MitcBlock:
     dV: np.ndarray
     split: int = 0
     v: np.ndarray | None = None
+    T: np.ndarray | None = None  # (e, z, 9, 6, 6) Cartesian = T · covariant strain (inelastic layers only)
 
     @property
     def n_dof(self) -> int:
@@ -309,7 +310,7 @@ def strain_frames(X, H_below, H, points, zeta, frame: str = "center"):
 
 def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 0.0, direction=None,
                n_thickness: int = 3, full: bool = False, frame: str = "center", consistent: bool = True,
-               plies=None) -> MitcBlock:
+               plies=None, keep_map: bool = False) -> MitcBlock:
     """Precompute one layer for elements ``X (e, 9, 3)`` (arguments as :func:`kernel.layer_block`;
     ``frame`` see :func:`strain_frames`; ``consistent=False`` leaves out the consistency
     correction of the tying, module docstring, for comparison). With ``plies`` the thickness
@@ -346,7 +347,8 @@ def mitc_block(X, H_below, H, d: int, material: Orthotropic, angle_deg: float = 
     N, dN, _ = _quad9(tie.points)
     return MitcBlock(d, tie, N, dN, np.ascontiguousarray(thL.transpose(0, 2, 1)),
                      np.ascontiguousarray(F.transpose(0, 2, 1, 3, 4)), np.ascontiguousarray(M.transpose(0, 2, 1, 3, 4)),
-                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)), split, v)
+                     Ct, L, Cz, np.ascontiguousarray(dV.transpose(0, 2, 1).reshape(e, z * q)), split, v,
+                     np.ascontiguousarray(T.transpose(0, 2, 1, 3, 4)) if keep_map else None)
 
 
 def tie_correction(tie: Tying, detG: np.ndarray, Hp: np.ndarray) -> np.ndarray:
@@ -424,8 +426,12 @@ def natural_gradients(block: MitcBlock, sl: slice = slice(None)) -> np.ndarray:
 
 
 def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = True, tangent: bool = True,
-                            sl: slice = slice(None)):
-    """Plain NumPy form of the MITC9 layer response (module docstring): ``f (e, m)``, ``K (e, m, m)``."""
+                            sl: slice = slice(None), stress=None):
+    """Plain NumPy form of the MITC9 layer response (module docstring): ``f (e, m)``, ``K (e, m, m)``.
+
+    ``stress(E) -> (S, D)``: the Cartesian stress and tangent at the Gauss points (``(e, z·9, 6)``,
+    ``(e, z·9, 6, 6)``, z-major as ``block.dV``) from the Cartesian tied strain E = T Ẽ, in place
+    of S̃ = C̃ Ẽ (inelastic layers, :mod:`.inelastic`; needs ``block.T``)."""
     dphi = np.einsum("ezpai,ezpib->ezpab", natural_gradients(block, sl), block.M[sl])  # along F_b
     Gc = np.swapaxes(block.G[sl], -1, -2)  # (e, z, P, i, k): G_i components k
     Ct = block.Ct[sl]
@@ -447,7 +453,17 @@ def mitc_response_reference(block: MitcBlock, U: np.ndarray, nonlinear: bool = T
         Vd = _dense_correction(block.tie, block.v[sl])  # (e, z, c, P)
         Et = Et + np.einsum("ezcp,ezpc->ezc", Vd, Ev)[:, :, None]
         Bt = Bt + np.einsum("ezcp,ezpcak->ezcak", Vd, B)[:, :, None]
-    S = np.einsum("ezqcd,ezqd->ezqc", Ct, Et)
+    if stress is None:
+        S = np.einsum("ezqcd,ezqd->ezqc", Ct, Et)
+    else:  # Cartesian E = T Ẽ; S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV
+        T = block.T[sl]
+        ne, nz, nq = Et.shape[:3]
+        Sc, D = stress(np.einsum("ezqVc,ezqc->ezqV", T, Et).reshape(ne, nz * nq, 6))
+        dV = block.dV[sl].reshape(ne, nz, nq)
+        S = np.einsum("ezqVc,ezqV->ezqc", T, Sc.reshape(ne, nz, nq, 6)) * dV[..., None]
+        if tangent:
+            Ct = np.einsum("ezqVc,ezqVW,ezqWd->ezqcd", T, D.reshape(ne, nz, nq, 6, 6), T,
+                           optimize=True) * dV[..., None, None]
     e, a = U.shape[:2]
     m = 3 * a
     f = np.einsum("ezqcak,ezqc->eak", Bt, S).reshape(e, m)

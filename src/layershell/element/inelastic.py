@@ -1,0 +1,268 @@
+"""Inelastic layers: the stress and tangent of a material law at every integration point of a
+layer, and reinforcement sheets (rebar, textile) inside a layer without extra DOFs.
+
+Bulk. The layer kernels' plain forms (:func:`.kernel.layer_response_reference`,
+:func:`.mitc.mitc_response_reference`) with the PK2 stress S and the tangent D = dS/dE of the law at
+the Green-Lagrange strain of each point (MITC9: the tied strain mapped to Cartesian axes) in
+place of S = C E: f = Σ Bᵀ S dV, K = Σ Bᵀ D B dV + the geometric term of S. The law sees the
+shell normal and two lengths per point for its crack band: the element's in-plane size
+h_in = √(element area) and the thickness-point spacing h_z = H / (points through the layer).
+
+Sheets. A reinforcement sheet at height ``h`` above the layer's bottom face with the unit
+direction a (the tangent-plane projection of a global direction, turned by an angle about the
+normal) and the area A_s per unit width (bars: area per bar / spacing) is a uniaxial material
+bonded to the layer: its strain is the layer's Green-Lagrange strain along a there,
+ε = a·E·a = (∇u a)·a + ½ |∇u a|², at the 3 × 3 in-plane Gauss points, so with F a and g_a·a
+
+    f_ai = Σ_q w_q σ (g_a·a) (F a)_i,   K_aibk = Σ_q w_q [E_t (g_a·a)(F a)_i (g_b·a)(F a)_k + σ (g_a·a)(g_b·a) δ_ik]
+
+and w_q = A_s dA (dA the area element at the sheet's height). The sheet uses the layer's
+untied strain also in a MITC9 layer.
+
+State. Every response is a pure function of the displacement and the committed state and
+returns the trial state; the solver commits the trial state of a converged solution
+(:meth:`layershell.assembly.Assembler.commit`), so that a rejected iterate or increment leaves no
+trace.
+"""
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from .geometry import shell_basis, surface_points
+from .kernel import (LayerBlock, basis_gradients, layer_block, layer_response, layer_response_reference,
+                     material_frame)
+from .quadrature import gauss_2d
+
+
+@dataclass(frozen=True)
+class Sheet:
+    """A reinforcement sheet over a block's elements: ``g (e, q, a, 3)`` the basis gradients at its
+    points, ``a (e, q, 3)`` its unit direction, ``w (e, q)`` the sheet area per point (A_s dA)."""
+
+    name: str
+    law: object
+    g: np.ndarray
+    a: np.ndarray
+    w: np.ndarray
+
+
+@dataclass(frozen=True)
+class InelasticBlock:
+    """A layer with a bulk material law (``law``, or None: the elastic ``base``) and sheets.
+
+    ``h_in``, ``h_z`` (e, P): crack-band lengths, ``normal`` (e, P, 3) the shell normal at the
+    base block's P points (in its order: ``base.dV``)."""
+
+    base: object
+    law: object | None
+    h_in: np.ndarray
+    h_z: np.ndarray
+    normal: np.ndarray
+    sheets: tuple[Sheet, ...] = ()
+
+    @property
+    def n_dof(self) -> int:
+        return self.base.n_dof
+
+    @property
+    def n_points(self) -> int:
+        return self.base.dV.shape[1]
+
+    @property
+    def d(self) -> int:
+        return self.base.d
+
+    @property
+    def dV(self) -> np.ndarray:
+        return self.base.dV
+
+    @property
+    def C(self) -> np.ndarray:
+        return self.base.C
+
+    @property
+    def symmetric(self) -> bool:
+        """Whether the tangent is symmetric (the sheets' always is; the bulk law says)."""
+        return self.law is None or bool(getattr(self.law, "symmetric", False))
+
+
+@dataclass
+class LayerState:
+    """Point states of one inelastic block: ``bulk`` (the law's, over e·P points, element-major)
+    and one per sheet (over e·9 points)."""
+
+    bulk: object | None
+    sheets: tuple
+
+    def copy(self) -> "LayerState":
+        return LayerState(_copy(self.bulk), tuple(_copy(s) for s in self.sheets))
+
+    def to_dict(self, prefix: str) -> dict[str, np.ndarray]:
+        out: dict[str, np.ndarray] = {}
+        if self.bulk is not None:
+            out.update(_arrays(self.bulk, f"{prefix}/bulk"))
+        for k, s in enumerate(self.sheets):
+            out.update(_arrays(s, f"{prefix}/sheet{k}"))
+        return out
+
+    def load(self, d: dict, prefix: str) -> "LayerState":
+        """The same state with the arrays of ``d`` (written by :meth:`to_dict`)."""
+        bulk = None if self.bulk is None else _from_arrays(self.bulk, d, f"{prefix}/bulk")
+        return LayerState(bulk, tuple(_from_arrays(s, d, f"{prefix}/sheet{k}") for k, s in enumerate(self.sheets)))
+
+
+def _fields(state) -> list[str]:
+    return [f.name for f in dataclasses.fields(state)]
+
+
+def _copy(state):
+    if state is None:
+        return None
+    return dataclasses.replace(state, **{k: np.array(getattr(state, k), copy=True) for k in _fields(state)})
+
+
+def _take(state, idx: slice):
+    return dataclasses.replace(state, **{k: getattr(state, k)[idx] for k in _fields(state)})
+
+
+def _put(dst, idx: slice, src) -> None:
+    for k in _fields(dst):
+        getattr(dst, k)[idx] = getattr(src, k)
+
+
+def _arrays(state, prefix: str) -> dict[str, np.ndarray]:
+    return {f"{prefix}/{k}": np.asarray(getattr(state, k)) for k in _fields(state)}
+
+
+def _from_arrays(like, d: dict, prefix: str):
+    vals = {}
+    for k in _fields(like):
+        key = f"{prefix}/{k}"
+        if key not in d or np.shape(d[key]) != np.shape(getattr(like, k)):
+            raise KeyError(key)
+        vals[k] = np.array(d[key], dtype=float)
+    return dataclasses.replace(like, **vals)
+
+
+def initial_state(block: InelasticBlock) -> LayerState:
+    """The virgin state of every point of ``block``."""
+    e = block.h_in.shape[0]
+    bulk = block.law.state(e * block.n_points) if block.law is not None else None
+    return LayerState(bulk, tuple(s.law.state(e * s.w.shape[1]) for s in block.sheets))
+
+
+def _point_geometry(base, sp, Hq: np.ndarray, w2: np.ndarray):
+    """h_in, h_z, normal at the base block's points (LayerBlock q-major, MITC9 z-major)."""
+    e, q = Hq.shape
+    nz = base.dV.shape[1] // q
+    h_in = np.sqrt(np.sum(sp.sqrtA * w2, axis=1))  # √(element area)
+    hz = Hq / nz
+    if isinstance(base, LayerBlock):  # point = iq · nz + iz
+        normal = np.repeat(sp.A3, nz, axis=1)
+        h_z = np.repeat(hz, nz, axis=1)
+    else:  # point = iz · 9 + iq
+        normal = np.tile(sp.A3, (1, nz, 1))
+        h_z = np.tile(hz, (1, nz))
+    return np.repeat(h_in[:, None], base.dV.shape[1], axis=1), h_z, normal
+
+
+def sheet_block(X, H_below, H, d: int, height: float, area: float, law, name: str, angle_deg: float = 0.0,
+                direction=None) -> Sheet:
+    """A sheet at ``height`` above the layer's bottom face (``H_below``, ``H`` nodal (e, 9))."""
+    pts, w2 = gauss_2d(3)
+    sp = surface_points(X, pts[:, 0], pts[:, 1])
+    Hb = sp.interpolate(H_below)
+    th = np.full(Hb.shape + (1,), float(height))
+    _, Ginv, detG = shell_basis(sp, Hb[..., None] + th)
+    g = basis_gradients(sp, Ginv, th, d)[:, :, 0]
+    a = material_frame(sp, angle_deg, direction)[..., 0, :]
+    w = float(area) * detG[..., 0] * w2[None, :]
+    return Sheet(name, law, np.ascontiguousarray(g), np.ascontiguousarray(a), w)
+
+
+def inelastic_block(X, H_below, H, d: int, material, law, sheets=(), n_thickness: int = 3,
+                    element: str = "mitc", angle_deg: float = 0.0, direction=None) -> InelasticBlock:
+    """The block of a layer with the bulk ``law`` (or None) and ``sheets``: (name, law, height,
+    area, angle, direction) each. ``material`` is the law's initial elastic stand-in (estimates,
+    the base block's C)."""
+    base = layer_block(X, H_below, H, d, material, angle_deg, direction, n_thickness, element=element,
+                       keep_map=law is not None)
+    pts, w2 = gauss_2d(3)
+    sp = surface_points(X, pts[:, 0], pts[:, 1])
+    h_in, h_z, normal = _point_geometry(base, sp, sp.interpolate(H), w2)
+    made = tuple(sheet_block(X, H_below, H, d, h, A, lw, nm, ang, dr) for nm, lw, h, A, ang, dr in sheets)
+    return InelasticBlock(base, law, h_in, h_z, normal, made)
+
+
+def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed):
+    """Forces ``(e, m)``, tangent ``(e, m, m)`` (None without ``tangent``) and trial state of a sheet."""
+    g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
+    Ha = np.einsum("eai,eqaJ,eqJ->eqi", U, g, a)  # ∇u a
+    eps = np.einsum("eqi,eqi->eq", Ha, a)
+    Fa = a + Ha if nonlinear else a
+    if nonlinear:
+        eps = eps + 0.5 * np.einsum("eqi,eqi->eq", Ha, Ha)
+    sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
+    e, q = eps.shape
+    sig = sig.reshape(e, q)
+    ga = np.einsum("eqaJ,eqJ->eqa", g, a)
+    Bq = ga[:, :, :, None] * Fa[:, :, None, :]  # (e, q, a, 3) = dε/dU_ai
+    m = Bq.shape[2] * 3
+    f = np.einsum("eqai,eq->eai", Bq, sig * w).reshape(e, m)
+    if not tangent:
+        return f, None, trial
+    Bm = Bq.reshape(e, q, m)
+    K = np.einsum("eqm,eq,eqn->emn", Bm, Et.reshape(e, q) * w, Bm, optimize=True)
+    if nonlinear:
+        Kg = np.einsum("eqa,eq,eqb->eab", ga, sig * w, ga)
+        na = ga.shape[2]
+        K = (K.reshape(e, na, 3, na, 3) + Kg[:, :, None, :, None] * np.eye(3)[None, None, :, None, :]).reshape(e, m, m)
+    return f, K, trial
+
+
+def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice,
+                       committed: LayerState):
+    """Forces ``(e, m)``, tangent ``(e, m, m)`` and the trial :class:`LayerState` of the elements
+    ``sl`` (a contiguous range) from their nodal vectors ``U (e, a, 3)`` and the committed state
+    of the whole block."""
+    lo, hi, _ = sl.indices(block.h_in.shape[0])
+    sl = slice(lo, hi)
+    trial_bulk = None
+    if block.law is None:
+        f, K = layer_response(block.base, U, nonlinear, tangent, sl)
+    else:
+        P = block.n_points
+        c = _take(committed.bulk, slice(lo * P, hi * P))
+        out = {}
+
+        def stress(E):
+            S, D, out["trial"] = block.law.response(E.reshape(-1, 6), c, block.h_in[sl].ravel(),
+                                                    block.h_z[sl].ravel(), block.normal[sl].reshape(-1, 3), tangent)
+            ne = E.shape[0]
+            return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
+
+        f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
+        trial_bulk = out["trial"]
+    trial_sheets = []
+    for k, s in enumerate(block.sheets):
+        q = s.w.shape[1]
+        fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, _take(committed.sheets[k], slice(lo * q, hi * q)))
+        f = f + fs
+        if tangent:
+            K = K + Ks
+        trial_sheets.append(tr)
+    return f, K, LayerState(trial_bulk, tuple(trial_sheets))
+
+
+def put_trial(full: LayerState, block: InelasticBlock, sl: slice, part: LayerState) -> None:
+    """Write the trial state ``part`` of the elements ``sl`` into the block-wide ``full``."""
+    lo, hi, _ = sl.indices(block.h_in.shape[0])
+    if part.bulk is not None:
+        P = block.n_points
+        _put(full.bulk, slice(lo * P, hi * P), part.bulk)
+    for k, s in enumerate(block.sheets):
+        q = s.w.shape[1]
+        _put(full.sheets[k], slice(lo * q, hi * q), part.sheets[k])

@@ -1,0 +1,143 @@
+"""Inelastic layers in the element kernels (element/inelastic.py): a law that is the elastic
+material reproduces the elastic kernels (full and MITC9), the tangents of nonlinear laws and of
+reinforcement sheets equal finite differences of the forces, and a sheet's axial stiffness adds
+E_s A_s to the layer's."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pytest
+
+from layershell.element.inelastic import initial_state, inelastic_block, inelastic_response, put_trial
+from layershell.element.kernel import layer_block, layer_response_reference
+from layershell.element.shape import NODE_XI
+from layershell.material import Orthotropic
+
+
+@dataclass(frozen=True)
+class _Hist:
+    emax: np.ndarray
+
+
+class _CubicBulk:
+    """S = C E + β (E·E) E with an irreversible history max |E| (a nonlinear law with a state)."""
+
+    def __init__(self, mat: Orthotropic, beta: float):
+        self.C, self.beta = mat.stiffness(), beta
+
+    def state(self, n):
+        return _Hist(np.zeros(n))
+
+    def response(self, eps, committed, h_in, h_z, normal, tangent=True):
+        assert eps.shape[0] == h_in.shape[0] == h_z.shape[0] == normal.shape[0]
+        e2 = np.einsum("pv,pv->p", eps, eps)
+        S = eps @ self.C.T + self.beta * e2[:, None] * eps
+        D = None
+        if tangent:
+            D = (self.C[None] + self.beta * (e2[:, None, None] * np.eye(6) + 2 * eps[:, :, None] * eps[:, None, :]))
+        return S, D, _Hist(np.maximum(committed.emax, np.sqrt(e2)))
+
+
+class _CubicSheet:
+    symmetric = True
+
+    def __init__(self, E, c):
+        self.E, self.c = E, c
+
+    def state(self, n):
+        return _Hist(np.zeros(n))
+
+    def response(self, eps, committed, tangent=True):
+        return (self.E * eps + self.c * eps ** 3, (self.E + 3 * self.c * eps ** 2) if tangent else None,
+                _Hist(np.maximum(committed.emax, np.abs(eps))))
+
+
+def _geometry(n_el=3, seed=0):
+    rng = np.random.default_rng(seed)
+    xi, eta = NODE_XI.T
+    X = np.zeros((n_el, 9, 3))
+    for e in range(n_el):
+        X[e, :, 0] = 2.0 * e + xi + 0.05 * rng.standard_normal(9)
+        X[e, :, 1] = 0.8 * eta + 0.05 * rng.standard_normal(9)
+        X[e, :, 2] = 0.1 * xi * eta + 0.02 * rng.standard_normal(9)
+    Hb = np.full((n_el, 9), 0.05)
+    H = 0.2 + 0.01 * rng.random((n_el, 9))
+    return X, Hb, H
+
+
+MAT = Orthotropic.isotropic(30000.0, 0.2)
+
+
+@pytest.mark.parametrize("element", ["full", "mitc"])
+@pytest.mark.parametrize("d", [1, 2])
+def test_elastic_law_reproduces_the_elastic_kernel(element, d):
+    X, Hb, H = _geometry()
+    blk = inelastic_block(X, Hb, H, d, MAT, _CubicBulk(MAT, 0.0), (), 3, element)
+    ref = layer_block(X, Hb, H, d, MAT, n_thickness=3, element=element)
+    U = 0.02 * np.random.default_rng(1).standard_normal((3, 9 * (d + 1), 3))
+    f, K, _ = inelastic_response(blk, U, True, True, slice(None), initial_state(blk))
+    f0, K0 = layer_response_reference(ref, U, True, True)
+    assert np.abs(f - f0).max() < 1e-10 * np.abs(f0).max()
+    assert np.abs(K - K0).max() < 1e-10 * np.abs(K0).max()
+
+
+def _fd_check(blk, U, state, h=1e-7):
+    f, K, _ = inelastic_response(blk, U, True, True, slice(None), state)
+    Kfd = np.zeros_like(K)
+    flat = U.reshape(U.shape[0], -1)
+    for j in range(flat.shape[1]):
+        up, um = flat.copy(), flat.copy()
+        up[:, j] += h
+        um[:, j] -= h
+        fp, _, _ = inelastic_response(blk, up.reshape(U.shape), True, False, slice(None), state)
+        fm, _, _ = inelastic_response(blk, um.reshape(U.shape), True, False, slice(None), state)
+        Kfd[:, :, j] = (fp - fm) / (2 * h)
+    return np.abs(K - Kfd).max() / np.abs(K).max()
+
+
+@pytest.mark.parametrize("element", ["full", "mitc"])
+def test_tangent_of_a_nonlinear_law_with_sheets_equals_finite_differences(element):
+    X, Hb, H = _geometry(2)
+    sheets = (("bars x", _CubicSheet(200000.0, 5e7), 0.04, 0.003, 0.0, (1.0, 0.0, 0.0)),
+              ("bars 30", _CubicSheet(200000.0, -3e7), 0.15, 0.002, 30.0, None))
+    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 4e6), sheets, 3, element)
+    U = 0.01 * np.random.default_rng(2).standard_normal((2, 18, 3))
+    assert _fd_check(blk, U, initial_state(blk)) < 1e-6
+
+
+def test_trial_state_is_written_per_element_range_and_committed_state_untouched():
+    X, Hb, H = _geometry(3)
+    sheets = (("bars", _CubicSheet(200000.0, 0.0), 0.1, 0.003, 0.0, None),)
+    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 1e5), sheets, 3, "mitc")
+    U = 0.01 * np.random.default_rng(3).standard_normal((3, 18, 3))
+    c = initial_state(blk)
+    whole = inelastic_response(blk, U, True, False, slice(None), c)[2]
+    full = c.copy()
+    for lo in range(3):
+        put_trial(full, blk, slice(lo, lo + 1), inelastic_response(blk, U[lo:lo + 1], True, False,
+                                                                   slice(lo, lo + 1), c)[2])
+    assert np.array_equal(full.bulk.emax, whole.bulk.emax) and np.array_equal(full.sheets[0].emax, whole.sheets[0].emax)
+    assert not np.any(c.bulk.emax) and np.all(whole.bulk.emax > 0)
+
+
+def test_sheet_adds_its_axial_stiffness():
+    """A flat strip (length 2, width 1) pulled by a uniform axial strain: the axial force is
+    (E h + E_s A_s) ε per unit width (plane stress in y free: ν enters the layer's share only)."""
+    xi, eta = NODE_XI.T
+    X = np.stack([1 + xi, 0.5 + 0.5 * eta, 0 * xi], -1)[None]
+    H = np.full((1, 9), 0.2)
+    Hb = np.zeros((1, 9))
+    Es, As = 200000.0, 0.004
+    with_sheet = inelastic_block(X, Hb, H, 1, MAT, None, (("bars", _CubicSheet(Es, 0.0), 0.05, As, 0.0, (1, 0, 0)),),
+                                 3, "mitc")
+    bare = inelastic_block(X, Hb, H, 1, MAT, None, (), 3, "mitc")
+    eps = 1e-4
+    U = np.zeros((1, 18, 3))
+    U[0, 0::2, 0] = eps * X[0, :, 0]  # director 0 (node-major, then director)
+    f1 = inelastic_response(with_sheet, U, False, False, slice(None), initial_state(with_sheet))[0]
+    f0 = inelastic_response(bare, U, False, False, slice(None), initial_state(bare))[0]
+    right = X[0, :, 0] > 1.99
+    df = (f1 - f0).reshape(9, 2, 3)[right, :, 0]
+    assert df[:, 0].sum() == pytest.approx(Es * As * eps * 1.0, rel=1e-10)  # the force on director 0
+    assert df[:, 1].sum() == pytest.approx(Es * As * eps * 0.05, rel=1e-10)  # its moment Θ_L N on director 1
