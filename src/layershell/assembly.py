@@ -385,6 +385,8 @@ class Assembler:
 
         self.committed = {i: initial_state(b.ref) for i, b in enumerate(self.blocks) if isinstance(b.ref, InelasticBlock)}
         self.trial = {i: st.copy() for i, st in self.committed.items()}
+        if not model.point_states:  # (a second assembler of the same model, e.g. for probes, keeps the first's)
+            self._publish()
         self._pattern()
 
     @property
@@ -398,6 +400,16 @@ class Assembler:
             return
         self._layers(u_full, np.zeros(self.dm.n_full), None)
         self.committed = {i: st.copy() for i, st in self.trial.items()}
+        self._publish()
+
+    def _publish(self) -> None:
+        """Hand the committed states to the model's outputs (``Model.point_states``)."""
+        states: dict = {}
+        for i, st in self.committed.items():
+            b = self.blocks[i]
+            states.setdefault(b.layer, []).append((b.elements, b.ref, st))
+        self.model.point_states.clear()
+        self.model.point_states.update(states)
 
     def material_state(self) -> dict[str, np.ndarray]:
         """The committed point states as plain arrays (snapshots, checkpoints)."""
@@ -411,6 +423,7 @@ class Assembler:
         is missing or of another shape)."""
         self.committed = {i: st.load(arrays, f"block{i}") for i, st in self.committed.items()}
         self.trial = {i: st.copy() for i, st in self.committed.items()}
+        self._publish()
 
     def add_blocks(self, extra: list) -> None:
         """Add element-like blocks with ``.dofs (e, m)`` and ``.response(u) -> (f, K)`` (contact)

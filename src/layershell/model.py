@@ -182,6 +182,9 @@ class Model:
     nonlinear: bool = True
     element: str = "mitc"  # "mitc": MITC9 assumed strain (element/mitc.py); "full": fully integrated
     units: str = ""
+    # the committed point states of the inelastic layers, per layer: [(block, state), ...] (kept
+    # here by Assembler.commit for the outputs, results.evaluate_points)
+    point_states: dict = field(default_factory=dict, repr=False, compare=False)
     # delamination (MODEL.md §9-§10), keyed by the index of the layer above the interface
     interface_laws: dict = field(default_factory=dict)  # int -> InterfaceLaw
     initially_debonded: dict = field(default_factory=dict)  # int -> node indices

@@ -135,7 +135,13 @@ def evaluate_points(
         else:
             Ev = green_lagrange(Hg, model.nonlinear)
         M, C = _ply_law(ly, sp, thL / sp.interpolate(ly.thickness[conn])[:, 0])
-        S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
+        if ly.law is None:
+            S = voigt_to_matrix(np.einsum("svw,sw->sv", C, Ev))
+        else:  # the law's stress with the committed state of the nearest integration point
+            from .element.inelastic import point_stress
+
+            S = voigt_to_matrix(point_stress(model, k, elements[sel], xi[sel], eta[sel],
+                                             thL / sp.interpolate(ly.thickness[conn])[:, 0], Ev))
         sig = cauchy_stress(F, S)
         # deformed frame (2.101)-(2.104): m1 = F M1/|F M1|, m3 = n = g1 x g2/|.|
         gcov = np.einsum("siJ,sJa->sia", F, G[:, 0, 0])

@@ -548,6 +548,14 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
         history, legacy_pvd = _history(ck, restart)
         u, lam0, step0 = ck.u.copy(), ck.load_factor, ck.step
         _restore_zones(zones, ck.extra)
+        mat = {k[4:]: v for k, v in ck.extra.items() if k.startswith("mat/")}
+        if problem.assembler.inelastic:
+            try:
+                problem.assembler.set_material_state(mat)
+            except KeyError as exc:
+                raise checkpoint.CheckpointError(f"--restart '{restart}': the checkpoint lacks the material state "
+                                                 f"{exc} of the model's concrete/reinforcement; rerun without "
+                                                 "--restart") from None
         if ctl is not None:
             try:
                 ctl.restore(problem, ck.interface_state)
@@ -659,8 +667,9 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
     # solves freeze as loading (every one at its threshold: Hill's comparison solid), and on the
     # ENF it separated neither branch (docs/user-guide.md, ENF); a warning from it would be wrong
     # on every softening run or never given
+    # nor with inelastic layers: their softening makes the tangent indefinite without any buckling
     stab = (StabilityWatch(monotone=spec.path_following is None or spec.path_following.control != "arc_length")
-            if ctl is None or not ctl.cohesive() else None)
+            if (ctl is None or not ctl.cohesive()) and not problem.assembler.inelastic else None)
     prev_state = (0, 0.0)  # (step, λ) of the last converged state, whose inertia the next step brings
     # the states of the last steps, from which a bifurcation is located by bisection: only where a
     # state is a function of λ (no interface laws; geometrically nonlinear)
@@ -785,7 +794,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     summary["wall_seconds"] = round(wall0 + time.perf_counter() - t0, 4)
                     last = checkpoint.capture(st.step, st.load_factor, u, spec.load_factors, hash_,
                                               ctl.state(problem) if ctl is not None else None, summary,
-                                              [], {}, {**_zone_arrays(zones), **_path_arrays(st)})
+                                              [], {}, {**_zone_arrays(zones), **_path_arrays(st),
+                                                       **{f"mat/{k}": v for k, v in problem.assembler.material_state().items()}})
                     checkpoint.save(rcd.path(checkpoint.FILENAME), last, fsync=rcd.sync_due())
                     rcd.summary(summary)
                     log(f"step {st.step} converged: λ = {st.load_factor:.6g}, {st.iterations} iteration(s), "

@@ -91,3 +91,19 @@ def check_units(text: str) -> str:
 def axis_label(name: str, unit: str | None) -> str:
     """``name [unit]``, or ``name`` alone without a unit."""
     return f"{name} [{unit}]" if unit else name
+
+
+#: metres per length unit and newtons per force unit
+_METRES = {"m": 1.0, "dm": 0.1, "cm": 0.01, "mm": 1e-3, "µm": 1e-6, "um": 1e-6, "km": 1e3, "in": 0.0254, "ft": 0.3048}
+_NEWTONS = {"N": 1.0, "mN": 1e-3, "daN": 10.0, "kN": 1e3, "MN": 1e6, "GN": 1e9, "lbf": 4.4482216152605,
+            "kip": 4448.2216152605}
+
+
+def si_factors(units: Units) -> tuple[float, float]:
+    """(MPa per model stress unit, metres per model length unit) of known ``units``: for the
+    material defaults that codes give in MPa and metres (concrete strength classes, steel grades)."""
+    if not units.known:
+        raise ValueError("the model's units are not known")
+    m, n = _METRES[units.length], _NEWTONS[units.force]
+    return n / m ** 2 / 1e6, m
+

@@ -266,3 +266,32 @@ def put_trial(full: LayerState, block: InelasticBlock, sl: slice, part: LayerSta
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
         _put(full.sheets[k], slice(lo * q, hi * q), part.sheets[k])
+
+
+def point_stress(model, k: int, elements: np.ndarray, xi: np.ndarray, eta: np.ndarray, s: np.ndarray,
+                 E: np.ndarray) -> np.ndarray:
+    """The law's PK2 stress ``(p, 6)`` of layer ``k`` at strains ``E (p, 6)`` of points in
+    ``elements`` at (ξ, η) and layer fraction ``s`` (0 bottom, 1 top), each with the committed
+    state of the element's nearest integration point (``model.point_states``)."""
+    from .quadrature import gauss_1d
+
+    out = np.full(E.shape, np.nan)
+    gp, _ = gauss_2d(3)
+    iq = np.argmin((gp[None, :, 0] - xi[:, None]) ** 2 + (gp[None, :, 1] - eta[:, None]) ** 2, axis=1)
+    for blk_elements, blk, st in model.point_states.get(k, ()):
+        if blk.law is None:
+            continue
+        pos = np.searchsorted(blk_elements, elements)
+        inside = (pos < blk_elements.size) & (blk_elements[np.minimum(pos, blk_elements.size - 1)] == elements)
+        if not inside.any():
+            continue
+        nz = blk.n_points // 9
+        zeta, _ = gauss_1d(nz)
+        iz = np.argmin(np.abs((zeta[None, :] + 1) / 2 - s[inside, None]), axis=1)
+        j = iz * 9 + iq[inside] if not isinstance(blk.base, LayerBlock) else iq[inside] * nz + iz
+        e = pos[inside]
+        flat = e * blk.n_points + j
+        c = dataclasses.replace(st.bulk, **{f: getattr(st.bulk, f)[flat] for f in _fields(st.bulk)})
+        S, _, _ = blk.law.response(E[inside], c, blk.h_in[e, j], blk.h_z[e, j], blk.normal[e, j], False)
+        out[inside] = S
+    return out

@@ -24,7 +24,7 @@ from .. import mesh as meshmod
 from ..element.shape import EDGES
 from ..formula import FormulaError
 from ..material import MaterialError, Orthotropic, laminate_equivalent
-from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, Ply, SurfaceLoad, Symmetry, Tie
+from ..model import EdgeLoad, Fix, Hinge, Layer, Model, NodalLoad, Ply, Reinforcement, SurfaceLoad, Symmetry, Tie
 from ..solver.newton import NewtonSettings
 from . import schema
 from .errors import XYZ, InputError  # defined apart: io/probes.py needs them without importing this module
@@ -469,6 +469,12 @@ def _mesh(md, base: Path) -> meshmod.Mesh:
                          "quadrilaterals that meshio can read (Gmsh .msh, .vtu, ...)") from None
 
 
+def _stand_in(law, density: float = 0.0) -> Orthotropic:
+    """The initial elastic constants of a material law (estimates, mass): isotropic E, ν (a sheet's
+    ν = 0: it is not a layer material)."""
+    return Orthotropic.isotropic(law.E, getattr(law, "nu", 0.0), density, name=law.name)
+
+
 def _material(name: str, md) -> Orthotropic:
     bad = [k for k, v in md.model_dump().items() if isinstance(v, float) and not math.isfinite(v)]
     if bad:
@@ -873,14 +879,89 @@ def _check_slender(model: Model) -> None:
                          "mesh (e.g. mm against m, or the mesh file's 'scale')")
 
 
-def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray, mesh_type: str) -> Layer:
-    """The model's layer of ``ld`` (materials ``mats``, nodal thickness ``th``); a ply stack takes
-    its homogenised equivalent as the layer material (estimates only, :class:`Layer`)."""
+def _law(name: str, md, units: str | None):
+    """The material law of a ``concrete``, ``steel`` or ``textile`` table (:mod:`layershell.laws`),
+    with the code defaults of its class or grade in the model's units."""
+    from .. import laws
+    from ..units import Units, si_factors
+
+    need_units = getattr(md, "strength_class", None) or getattr(md, "f_ck", None) or getattr(md, "grade", None) \
+        or getattr(md, "fibre", None)
+    mpa, metre = 1.0, 1.0
+    if need_units:
+        try:
+            mpa, metre = si_factors(Units.parse(units))
+        except ValueError:
+            raise InputError(f"'materials.{name}': the defaults of a strength class, grade or fibre are in MPa and "
+                             "metres, so the model needs its units: add units = 'N, mm' (or 'kN, m', ...) to "
+                             "[model], or give every constant of the material in the model's units") from None
+    given = {k: v for k, v in md.model_dump(exclude={"type", "strength_class", "f_ck", "grade", "fibre",
+                                                       "density"}).items() if v is not None}
+    try:
+        if md.type == "concrete":
+            f_ck = md.f_ck if md.f_ck is not None else (_class_strength(name, md.strength_class)
+                                                        if md.strength_class is not None else None)
+            law = (laws.ConcreteLaw.from_class(f_ck, mpa, metre, name=name, **given) if f_ck is not None
+                   else laws.ConcreteLaw(name=name, nu=given.pop("nu", 0.2), **given))
+        elif md.type == "steel":
+            law = (laws.SteelLaw.from_grade(md.grade, mpa, name=name, **given) if md.grade is not None
+                   else laws.SteelLaw(name=name, **given))
+        else:
+            law = (laws.TextileLaw.from_fibre(md.fibre, mpa, name=name, **given) if md.fibre is not None
+                   else laws.TextileLaw(name=name, **given))
+        law.check()
+    except (MaterialError, ValueError) as exc:
+        raise InputError(f"'materials.{name}': {exc}") from None
+    return law
+
+
+def _class_strength(name: str, cls: str) -> float:
+    """f_ck in MPa of a strength class 'C30/37' (the cylinder strength before the slash)."""
+    import re
+
+    mt = re.fullmatch(r"\s*C\s*(\d+)\s*/\s*(\d+)\s*", cls)
+    if mt is None or not 12 <= int(mt.group(1)) <= 100:
+        raise InputError(f"'materials.{name}.strength_class': '{cls}' is no concrete strength class; write e.g. "
+                         "'C30/37' (cylinder/cube strength in MPa, C12/15 to C100/115), or give f_ck = 30")
+    return float(mt.group(1))
+
+
+def _reinforcement(ld: schema.LayerDef, i: int, laws: dict) -> tuple[Reinforcement, ...]:
+    out = []
+    for j, r in enumerate(ld.reinforcement):
+        direction = tuple(float(x) for x in r.direction) if r.direction is not None else None
+        name = r.name or f"{r.material} {j + 1}"
+        out.append(Reinforcement(name, laws[r.material], float(r.height), float(r.area_per_width()), float(r.angle),
+                                 direction))
+    return tuple(out)
+
+
+def _check_reinforcement(model: Model, mf: schema.ModelFile) -> None:
+    """Each sheet lies inside its layer's thickness wherever the layer exists."""
+    present = model.layers_present()
+    for k, ly in enumerate(model.layers):
+        for j, r in enumerate(ly.reinforcement):
+            th = ly.thickness[present[k]]
+            if th.size and not (r.height < th.min()):
+                node = np.flatnonzero(present[k])[int(np.argmin(th))]
+                raise InputError(f"'layers[{k}].reinforcement[{j}].height': {r.height:g} lies outside layer "
+                                 f"'{ly.name}', which is {th.min():.6g} thick at node {node} "
+                                 f"{model.mesh.nodes[node].round(6).tolist()}; give a height between 0 and the "
+                                 "layer's thickness, measured from its bottom face")
+
+
+def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray, mesh_type: str, laws: dict | None = None,
+           i: int = 0) -> Layer:
+    """The model's layer of ``ld`` (materials ``mats``, material laws ``laws``, nodal thickness
+    ``th``); a ply stack takes its homogenised equivalent as the layer material (estimates only,
+    :class:`Layer`); a concrete layer the law's initial elastic constants."""
+    laws = laws or {}
     direction = tuple(ld.direction) if ld.direction is not None else None
     if direction is None and mesh_type == "plate_with_circle":
         direction = (1.0, 0.0, 0.0)  # its elements' first coordinate lines turn around the front
     if ld.plies is None:
-        return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction)
+        return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction,
+                     law=laws.get(ld.material), reinforcement=_reinforcement(ld, i, laws))
     total = sum(p.thickness for p in ld.plies)
     plies = tuple(Ply(mats[p.material], p.angle, p.thickness / total) for p in ld.plies)
     equivalent = laminate_equivalent([(p.material, p.angle, p.fraction) for p in plies],
@@ -901,7 +982,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                          "dimensions") from None
     if not np.all(np.isfinite(m.nodes)):
         raise InputError("'mesh': the mesh has nodes with non-finite coordinates; check the mesh dimensions")
-    mats = {k: _material(k, v) for k, v in mf.materials.items()}
+    laws = {k: _law(k, v, mf.model.units) for k, v in mf.materials.items() if v.type in ("concrete", "steel", "textile")}
+    mats = {k: _material(k, v) if k not in laws else _stand_in(laws[k], v.density) for k, v in mf.materials.items()}
     names = [ly.name for ly in mf.layers]
     index = {n: i for i, n in enumerate(names)}
     layers = []
@@ -922,7 +1004,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
                              "computed in floating point; check the units of the thickness and of the mesh")
         if ld.direction is not None:
             _vec(ld.direction, f"layers[{i}].direction")
-        layers.append(_layer(ld, mats, th, mf.mesh.type))
+        layers.append(_layer(ld, mats, th, mf.mesh.type, laws, i))
 
     def layer_idx(name, field):
         if name is None:
@@ -975,6 +1057,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     except ValueError as exc:
         raise InputError(f"'stacks': {exc}") from None
     _check_slender(model)
+    _check_reinforcement(model, mf)
     first = stacks[0][0]
     if mf.mesh.surface == "middle":
         m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)

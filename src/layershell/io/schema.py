@@ -308,7 +308,91 @@ class OrthotropicMat(Strict):
         return self
 
 
-Material = Annotated[Union[Isotropic, OrthotropicMat], Field(discriminator="type")]
+class ConcreteMat(Strict):
+    type: Literal["concrete"]
+    strength_class: str | None = Field(None, description=(
+        "strength class 'C12/15' ... 'C90/105' (EN 1992 / fib Model Code 2010): every constant below from the "
+        "Model Code's mean values; needs [model] units"))
+    f_ck: PositiveFloat | None = Field(None, description="characteristic cylinder strength in MPa (instead of the class)")
+    E: PositiveFloat | None = Field(None, description="Young's modulus (force/area); default E_ci of the class")
+    nu: float | None = Field(None, description="Poisson's ratio, 0 <= nu < 0.5; default 0.2")
+    f_c: PositiveFloat | None = Field(None, description="uniaxial compressive strength, positive (force/area); default f_cm")
+    f_ct: PositiveFloat | None = Field(None, description="uniaxial tensile strength (force/area); default f_ctm")
+    G_F: PositiveFloat | None = Field(None, description="tensile fracture energy (force/length); default fib MC2010")
+    G_c: PositiveFloat | None = Field(None, description="compressive fracture energy (force/length)")
+    eps_c1: PositiveFloat | None = Field(None, description="strain at the compressive peak, positive")
+    density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
+
+    @model_validator(mode="after")
+    def _strength(self):
+        if self.strength_class is None and self.f_ck is None and None in (self.E, self.f_c, self.f_ct, self.G_F,
+                                                                             self.G_c, self.eps_c1):
+            raise ValueError("a concrete needs a strength: give strength_class = 'C30/37' (or f_ck = 30, in MPa), "
+                             "or all of E, f_c, f_ct, G_F, G_c and eps_c1 in the model's units")
+        if self.strength_class is not None and self.f_ck is not None:
+            raise ValueError("give strength_class or f_ck, not both")
+        return self
+
+
+class SteelMat(Strict):
+    type: Literal["steel"]
+    grade: str | None = Field(None, description="reinforcing steel grade 'B500A', 'B500B' or 'B500C' (needs [model] units)")
+    E: PositiveFloat | None = Field(None, description="Young's modulus (force/area); default 200 GPa")
+    f_y: PositiveFloat | None = Field(None, description="yield strength (force/area)")
+    E_h: float | None = Field(None, ge=0, description="hardening modulus after yield (force/area)")
+    eps_u: PositiveFloat | None = Field(None, description="strain at rupture (none: no rupture)")
+    density: float = Field(0.0, ge=0, description="mass per volume")
+
+    @model_validator(mode="after")
+    def _strength(self):
+        if self.grade is None and (self.E is None or self.f_y is None):
+            raise ValueError("a steel needs a grade = 'B500B' or E and f_y in the model's units")
+        return self
+
+
+class TextileMat(Strict):
+    type: Literal["textile"]
+    fibre: Literal["carbon", "AR-glass"] | None = Field(None, description="typical values of a carbon or AR-glass "
+                                                                          "textile (needs [model] units)")
+    E: PositiveFloat | None = Field(None, description="Young's modulus of the yarns (force/area)")
+    f_t: PositiveFloat | None = Field(None, description="tensile strength of the yarns in the textile (force/area)")
+    density: float = Field(0.0, ge=0, description="mass per volume")
+
+    @model_validator(mode="after")
+    def _strength(self):
+        if self.fibre is None and (self.E is None or self.f_t is None):
+            raise ValueError("a textile needs fibre = 'carbon' or 'AR-glass', or E and f_t in the model's units")
+        return self
+
+
+Material = Annotated[Union[Isotropic, OrthotropicMat, ConcreteMat, SteelMat, TextileMat], Field(discriminator="type")]
+
+
+class ReinforcementDef(Strict):
+    material: str = Field(description="name of a [materials.NAME] table of type 'steel' or 'textile'")
+    height: PositiveFloat = Field(description="height of the sheet above the layer's bottom face (length)")
+    area: PositiveFloat | None = Field(None, description=(
+        "cross-section area per unit width (length²/length); or give bar_diameter and spacing"))
+    bar_diameter: PositiveFloat | None = Field(None, description="bar diameter (length), with spacing")
+    spacing: PositiveFloat | None = Field(None, description="bar spacing (length), with bar_diameter")
+    direction: Vec3 | None = Field(None, description="global direction of the bars, projected on the surface "
+                                                     "(default: the first coordinate line)")
+    angle: FiniteFloat = Field(0.0, description="angle in degrees about the normal from 'direction'")
+    name: str | None = Field(None, description="name in the outputs (default: material and direction)")
+
+    @model_validator(mode="after")
+    def _area(self):
+        bars = (self.bar_diameter is not None, self.spacing is not None)
+        if self.area is None and not all(bars):
+            raise ValueError("give the reinforcement's 'area' per unit width, or 'bar_diameter' and 'spacing'")
+        if self.area is not None and any(bars):
+            raise ValueError("give either 'area' or 'bar_diameter' with 'spacing', not both")
+        return self
+
+    def area_per_width(self) -> float:
+        if self.area is not None:
+            return self.area
+        return math.pi * self.bar_diameter ** 2 / 4.0 / self.spacing
 
 
 class PlyDef(Strict):
@@ -340,6 +424,9 @@ class LayerDef(Strict):
     plies: list[PlyDef] | None = Field(None, min_length=1, description=(
         "ply stack inside the layer, bottom to top, instead of 'material': [{material = 'cfrp', angle = 0, "
         "thickness = 0.125}, ...]; integrated ply by ply under the layer's directors, stresses per ply"))
+    reinforcement: list[ReinforcementDef] = Field(default_factory=list, description=(
+        "steel bars or textile inside the layer: [{material = 'b500', height = 0.03, bar_diameter = 0.01, spacing "
+        "= 0.2, direction = [1, 0, 0]}, ...], bonded to the layer (no extra unknowns)"))
 
     @field_validator("thickness")
     @classmethod
@@ -934,6 +1021,23 @@ class ModelFile(Strict):
                 if mat not in self.materials:
                     raise ValueError(f"'{at}': unknown material '{mat}'; defined: {sorted(self.materials)} (fix the "
                                      f"name or add a [materials.{mat}] table)")
+                kind = self.materials[mat].type
+                if kind in ("steel", "textile"):
+                    raise ValueError(f"'{at}': material '{mat}' is a {kind}, which acts in one direction only and "
+                                     "is placed inside a layer: give the layer a concrete or elastic material and "
+                                     f"add reinforcement = [{{material = '{mat}', height = ..., area = ...}}]")
+                if kind == "concrete" and ly.plies is not None:
+                    raise ValueError(f"'{at}': a ply stack takes elastic plies only, but '{mat}' is a concrete; "
+                                     "make the concrete its own layer")
+            for j, r in enumerate(ly.reinforcement):
+                at = f"layers[{i}].reinforcement[{j}].material"
+                if r.material not in self.materials:
+                    raise ValueError(f"'{at}': unknown material '{r.material}'; defined: {sorted(self.materials)} "
+                                     f"(fix the name or add a [materials.{r.material}] table of type 'steel' or "
+                                     "'textile')")
+                if self.materials[r.material].type not in ("steel", "textile"):
+                    raise ValueError(f"'{at}': reinforcement is of a material of type 'steel' or 'textile', but "
+                                     f"'{r.material}' is of type '{self.materials[r.material].type}'")
         zs = self.output.zone_steps
         n_steps = len(self.steps.factors) if self.steps.factors is not None else self.steps.n
         if zs and max(zs) > n_steps:

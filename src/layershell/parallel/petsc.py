@@ -89,6 +89,12 @@ def check_supported(model: Model) -> None:
     so changes the constraint operator and the sparsity pattern; contact-only interfaces)."""
     from ..cohesive import CohesiveLaw
 
+    inelastic = [ly.name for ly in model.layers if ly.inelastic]
+    if inelastic:
+        raise UnsupportedModelError(
+            f"distributed runs support elastic layers only, but layer(s) {', '.join(repr(n) for n in inelastic)} "
+            "have a concrete material or reinforcement (their point states are not distributed yet); run "
+            "serially with `layershell run`")
     other = sorted(model.layers[k].name for k, law in model.interface_laws.items() if not isinstance(law, CohesiveLaw))
     if other:
         names = ", ".join(f"'{n}'" for n in other)
@@ -124,6 +130,9 @@ class Timings:
 class DistributedProblem:
     """The static problem of a bonded model, or one with cohesive interfaces, distributed over the
     ranks of ``comm``."""
+
+    def commit(self, u) -> None:
+        """Nothing to commit: the layers are elastic (:func:`check_supported`)."""
 
     def __init__(self, model: Model, solver: str = "mumps", comm=None):
         check_supported(model)

@@ -1028,6 +1028,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
             st.size *= 0.5
         # accepted increment
+        problem.commit(att.u)
         du = att.u - u
         dlam = att.lam - lam
         conj = conjugates(problem, att.u) if displacement_path else None  # (v, R) at the new state

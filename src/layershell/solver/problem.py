@@ -129,16 +129,25 @@ class Problem:
                 out[k] = out.get(k, 0) + v
         return out
 
+    def commit(self, u: np.ndarray) -> None:
+        """Take the material state of the inelastic layers at the converged ``u`` as committed
+        (nothing without inelastic layers)."""
+        self.assembler.commit(u)
+
     def snapshot(self) -> dict:
         """Copy of the mutable delamination state (bond flags, per-point history, friction
-        anchors) to undo a load increment (step cutting); the same state a checkpoint saves."""
+        anchors) and of the inelastic layers' committed state, to undo a load increment (step
+        cutting); the same state a checkpoint saves."""
+        mat = self.assembler.material_state() if self.assembler.inelastic else None
         if self.interfaces is None:
-            return {"bonded": {k: v.copy() for k, v in self.bonded.items()}}
-        return {"state": self.interfaces.state(self), "resolves": self.interfaces.resolves}
+            return {"bonded": {k: v.copy() for k, v in self.bonded.items()}, "materials": mat}
+        return {"state": self.interfaces.state(self), "resolves": self.interfaces.resolves, "materials": mat}
 
     def restore(self, snap: dict) -> None:
         """Undo to a :meth:`snapshot`; rebuilds the constraint operator where the bond flags
         change."""
+        if snap.get("materials") is not None:
+            self.assembler.set_material_state(snap["materials"])
         if self.interfaces is None:
             for k, v in snap["bonded"].items():
                 self.bonded[k] = v.copy()
