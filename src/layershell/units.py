@@ -65,9 +65,9 @@ class Units:
     def of_probe(self, quantity: str, component: str | None = None) -> str:
         """Unit of a probe's value (before its ``scale``); "" for the load factor and unknown units."""
         component = component or ""
-        if quantity == "displacement":
+        if quantity in ("displacement", "crack_width"):
             return self.length
-        if quantity in ("stress", "traction"):
+        if quantity in ("stress", "traction", "rebar_stress"):
             return self.stress
         if quantity == "debonded_area":
             return self.area

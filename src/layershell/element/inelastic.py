@@ -92,13 +92,19 @@ class InelasticBlock:
 @dataclass
 class LayerState:
     """Point states of one inelastic block: ``bulk`` (the law's, over e·P points, element-major)
-    and one per sheet (over e·9 points)."""
+    and one per sheet (over e·9 points); ``strain`` (e·P, 6) the bulk strain and ``sheet_strain``,
+    ``sheet_stress`` (e·9,) per sheet at the state (outputs: crack widths, bar stresses)."""
 
     bulk: object | None
     sheets: tuple
+    strain: np.ndarray | None = None
+    sheet_strain: tuple = ()
+    sheet_stress: tuple = ()
 
     def copy(self) -> "LayerState":
-        return LayerState(_copy(self.bulk), tuple(_copy(s) for s in self.sheets))
+        return LayerState(_copy(self.bulk), tuple(_copy(s) for s in self.sheets),
+                          None if self.strain is None else self.strain.copy(),
+                          tuple(a.copy() for a in self.sheet_strain), tuple(a.copy() for a in self.sheet_stress))
 
     def to_dict(self, prefix: str) -> dict[str, np.ndarray]:
         out: dict[str, np.ndarray] = {}
@@ -106,12 +112,26 @@ class LayerState:
             out.update(_arrays(self.bulk, f"{prefix}/bulk"))
         for k, s in enumerate(self.sheets):
             out.update(_arrays(s, f"{prefix}/sheet{k}"))
+            out[f"{prefix}/sheet{k}.strain"] = self.sheet_strain[k]
+            out[f"{prefix}/sheet{k}.stress"] = self.sheet_stress[k]
+        if self.strain is not None:
+            out[f"{prefix}/strain"] = self.strain
         return out
 
     def load(self, d: dict, prefix: str) -> "LayerState":
         """The same state with the arrays of ``d`` (written by :meth:`to_dict`)."""
         bulk = None if self.bulk is None else _from_arrays(self.bulk, d, f"{prefix}/bulk")
-        return LayerState(bulk, tuple(_from_arrays(s, d, f"{prefix}/sheet{k}") for k, s in enumerate(self.sheets)))
+
+        def arr(key, like):
+            if key not in d or np.shape(d[key]) != np.shape(like):
+                raise KeyError(key)
+            return np.array(d[key], dtype=float)
+
+        n = len(self.sheets)
+        return LayerState(bulk, tuple(_from_arrays(s, d, f"{prefix}/sheet{k}") for k, s in enumerate(self.sheets)),
+                          None if self.strain is None else arr(f"{prefix}/strain", self.strain),
+                          tuple(arr(f"{prefix}/sheet{k}.strain", self.sheet_strain[k]) for k in range(n)),
+                          tuple(arr(f"{prefix}/sheet{k}.stress", self.sheet_stress[k]) for k in range(n)))
 
 
 def _fields(state) -> list[str]:
@@ -151,7 +171,10 @@ def initial_state(block: InelasticBlock) -> LayerState:
     """The virgin state of every point of ``block``."""
     e = block.h_in.shape[0]
     bulk = block.law.state(e * block.n_points) if block.law is not None else None
-    return LayerState(bulk, tuple(s.law.state(e * s.w.shape[1]) for s in block.sheets))
+    nq = [e * s.w.shape[1] for s in block.sheets]
+    return LayerState(bulk, tuple(s.law.state(n) for s, n in zip(block.sheets, nq)),
+                      np.zeros((e * block.n_points, 6)) if bulk is not None else None,
+                      tuple(np.zeros(n) for n in nq), tuple(np.zeros(n) for n in nq))
 
 
 def _point_geometry(base, sp, Hq: np.ndarray, w2: np.ndarray):
@@ -207,6 +230,7 @@ def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, 
         eps = eps + 0.5 * np.einsum("eqi,eqi->eq", Ha, Ha)
     sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
     e, q = eps.shape
+    trial = (trial, eps.ravel(), sig.ravel())
     sig = sig.reshape(e, q)
     ga = np.einsum("eqaJ,eqJ->eqa", g, a)
     Bq = ga[:, :, :, None] * Fa[:, :, None, :]  # (e, q, a, 3) = dε/dU_ai
@@ -239,22 +263,26 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
         out = {}
 
         def stress(E):
-            S, D, out["trial"] = block.law.response(E.reshape(-1, 6), c, block.h_in[sl].ravel(),
+            out["strain"] = E.reshape(-1, 6)
+            S, D, out["trial"] = block.law.response(out["strain"], c, block.h_in[sl].ravel(),
                                                     block.h_z[sl].ravel(), block.normal[sl].reshape(-1, 3), tangent)
             ne = E.shape[0]
             return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
 
         f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
         trial_bulk = out["trial"]
-    trial_sheets = []
+    trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
         fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, _take(committed.sheets[k], slice(lo * q, hi * q)))
         f = f + fs
         if tangent:
             K = K + Ks
-        trial_sheets.append(tr)
-    return f, K, LayerState(trial_bulk, tuple(trial_sheets))
+        trial_sheets.append(tr[0])
+        strains.append(tr[1])
+        stresses.append(tr[2])
+    return f, K, LayerState(trial_bulk, tuple(trial_sheets), out.get("strain") if block.law is not None else None,
+                            tuple(strains), tuple(stresses))
 
 
 def put_trial(full: LayerState, block: InelasticBlock, sl: slice, part: LayerState) -> None:
@@ -263,9 +291,12 @@ def put_trial(full: LayerState, block: InelasticBlock, sl: slice, part: LayerSta
     if part.bulk is not None:
         P = block.n_points
         _put(full.bulk, slice(lo * P, hi * P), part.bulk)
+        full.strain[lo * P:hi * P] = part.strain
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
         _put(full.sheets[k], slice(lo * q, hi * q), part.sheets[k])
+        full.sheet_strain[k][lo * q:hi * q] = part.sheet_strain[k]
+        full.sheet_stress[k][lo * q:hi * q] = part.sheet_stress[k]
 
 
 def point_stress(model, k: int, elements: np.ndarray, xi: np.ndarray, eta: np.ndarray, s: np.ndarray,
@@ -295,3 +326,26 @@ def point_stress(model, k: int, elements: np.ndarray, xi: np.ndarray, eta: np.nd
         S, _, _ = blk.law.response(E[inside], c, blk.h_in[e, j], blk.h_z[e, j], blk.normal[e, j], False)
         out[inside] = S
     return out
+
+
+def layer_point_values(model, k: int, quantity: str, sheet: str | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Values at the integration points of layer ``k`` in the committed state and the element of
+    each point: ``crack_width`` (the law's crack width, 0 where uncracked), ``rebar_stress`` or
+    ``rebar_strain`` of the sheet named ``sheet`` (None: every sheet of the layer)."""
+    vals, els = [], []
+    for blk_elements, blk, st in model.point_states.get(k, ()):
+        if quantity == "crack_width":
+            if blk.law is None or not hasattr(blk.law, "crack"):
+                continue
+            w, _ = blk.law.crack(st.strain, st.bulk)
+            vals.append(np.asarray(w, float))
+            els.append(np.repeat(blk_elements, blk.n_points))
+            continue
+        for j, s in enumerate(blk.sheets):
+            if sheet is not None and s.name != sheet:
+                continue
+            vals.append(st.sheet_stress[j] if quantity == "rebar_stress" else st.sheet_strain[j])
+            els.append(np.repeat(blk_elements, s.w.shape[1]))
+    if not vals:
+        return np.zeros(0), np.zeros(0, np.int64)
+    return np.concatenate(vals), np.concatenate(els)

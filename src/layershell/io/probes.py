@@ -20,6 +20,10 @@ class ProbeError(ValueError):
     pass
 
 
+#: probes over the integration points of inelastic layers (element/inelastic.py)
+MATERIAL_QUANTITIES = ("crack_width", "rebar_stress", "rebar_strain")
+
+
 @dataclass
 class Probe:
     name: str
@@ -158,6 +162,21 @@ class Probe:
         val = {"n": wt @ s11, "m": wt @ (s11 * arm), "q": wt @ s13, "nt": wt @ s12, "mt": wt @ (s12 * arm)}[c]
         return float(val)
 
+    def material_value(self, model) -> float:
+        """A crack width or reinforcement stress/strain over the layer's points (committed state)."""
+        from ..element.inelastic import layer_point_values
+
+        v, el = layer_point_values(model, self.layer, self.quantity, self.component or None)
+        if self.where is not None and v.size:
+            c = model.mesh.nodes[model.mesh.elements[el]].mean(axis=1)
+            v = v[np.asarray(self.where(x=c[:, 0], y=c[:, 1], z=c[:, 2]), bool)]
+        if v.size == 0:
+            return 0.0
+        r = self.reduce if self.reduce != "none" else "max"
+        if r == "absmax":
+            return float(v[np.argmax(np.abs(v))])
+        return float({"max": v.max, "min": v.min, "mean": v.mean}[r]())
+
     def value(self, model, dm, u, load_factor: float = 0.0, interfaces=None, problem=None) -> float:
         """The probe's value at displacements ``u`` (full vector), load factor and interface states."""
         if self.quantity == "reaction":
@@ -168,6 +187,8 @@ class Probe:
             return self.scale * float(load_factor)
         if self.quantity == "debonded_area":
             return self.scale * self.debonded_area(interfaces)
+        if self.quantity in MATERIAL_QUANTITIES:
+            return self.scale * self.material_value(model)
         v = self.samples(model, dm, u, load_factor)
         if self.reduce == "max":
             return float(v.max())
@@ -318,7 +339,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         if pd.direction is not None or pd.about is not None:
             raise InputError(f"'{f}': 'direction' and 'about' belong to resultant probes; remove them from this "
                              f"{pd.quantity} probe")
-        if pd.quantity in ("debonded_area", "load_factor"):
+        if pd.quantity in ("debonded_area", "load_factor", *MATERIAL_QUANTITIES):
             out.append(_global_probe(pd, f, k, model, node_selection))
             continue
         comp = pd.component
@@ -494,6 +515,8 @@ def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     from .errors import XYZ, InputError
     from .errors import formula as _formula
 
+    if pd.quantity in MATERIAL_QUANTITIES:
+        return _material_probe(pd, f, k, model)
     unused = {"point": pd.point, "set": pd.set, "component": pd.component}
     if pd.quantity == "load_factor":
         unused |= {"layer": pd.layer, "where": pd.where}
@@ -518,3 +541,38 @@ def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
     empty = np.zeros(0)
     return Probe(pd.name, pd.quantity, "", pd.measure, empty.astype(np.int64), empty, empty, empty, k, False,
                  pd.reduce, pd.scale, where, unit=pd.unit)
+
+
+def _material_probe(pd, f: str, k: int | None, model) -> Probe:
+    """A crack-width or reinforcement probe of layer ``k``, checked against the layer's law and sheets."""
+    from .errors import XYZ, InputError
+    from .errors import formula as _formula
+
+    extra = [key for key, v in (("point", pd.point), ("set", pd.set), ("theta3", pd.theta3 != 0.0)) if v]
+    if extra:
+        raise InputError(f"'{f}': a {pd.quantity} probe takes no {', '.join(map(repr, extra))} (it reduces over "
+                         "the layer's integration points; select elements with 'where')")
+    if k is None:
+        raise InputError(f"'{f}.layer': a {pd.quantity} probe needs the layer it reads")
+    ly = model.layers[k]
+    if pd.quantity == "crack_width" and ly.law is None:
+        raise InputError(f"'{f}.layer': layer '{ly.name}' is not of a concrete material, so it has no cracks; name "
+                         "a layer whose material has type = 'concrete'")
+    if pd.quantity != "crack_width":
+        names = [r.name for r in ly.reinforcement]
+        if not names:
+            raise InputError(f"'{f}.layer': layer '{ly.name}' has no reinforcement; name a layer with "
+                             "reinforcement = [...]")
+        if pd.component is not None and pd.component not in names:
+            raise InputError(f"'{f}.component': layer '{ly.name}' has no reinforcement '{pd.component}'; its "
+                             f"reinforcement is {names} (or leave component out for all)")
+    where = None
+    if pd.where is not None:
+        fm, tol = _formula(pd.where, XYZ, f"{f}.where"), 1e-6 * model.mesh.size()
+
+        def where(**xyz):
+            return fm(tol=tol, **xyz)
+    empty = np.zeros(0)
+    return Probe(pd.name, pd.quantity, pd.component or "", pd.measure, empty.astype(np.int64), empty, empty, empty,
+                 k, False, pd.reduce, pd.scale, where, unit=pd.unit)
+

@@ -718,8 +718,11 @@ class ProbeDef(Strict):
     name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description=(
         "column name in probes.csv and summary.json"))
     quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor", "reaction",
-                      "resultant"] = Field(
-        description="debonded_area: released area of the interface below `layer` (within `where`, a formula "
+                      "resultant", "crack_width", "rebar_stress", "rebar_strain"] = Field(
+        description="crack_width, rebar_stress, rebar_strain: over the integration points of the concrete layer / "
+                    "the reinforcement of `layer` (component: the reinforcement's name, default all) whose element "
+                    "centre satisfies `where`, reduced by `reduce` (default max); "
+                    "debonded_area: released area of the interface below `layer` (within `where`, a formula "
                     "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units); "
                     "reaction: force (component x|y|z) or moment about the origin (mx|my|mz) that the supports "
                     "exert at the selected nodes (where/set/point), R = f_int − F_ext summed over the nodes' "
