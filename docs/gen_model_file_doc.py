@@ -38,7 +38,17 @@ SECTIONS = [
     ("[materials.NAME] type = \"isotropic\"", schema.Isotropic, "Isotropic linear elastic material."),
     ("[materials.NAME] type = \"orthotropic\"", schema.OrthotropicMat,
      "Orthotropic material, nine constants in the material frame (axis 3 = shell normal)."),
+    ("[materials.NAME] type = \"concrete\"", schema.ConcreteMat,
+     "Cracking and crushing concrete (a layer's material; theory: docs/concrete.md). A strength class gives every "
+     "constant from the fib Model Code 2010 mean values; any constant given overrides it."),
+    ("[materials.NAME] type = \"steel\"", schema.SteelMat,
+     "Reinforcing steel, elastic-plastic with hardening, for `reinforcement` inside a layer."),
+    ("[materials.NAME] type = \"textile\"", schema.TextileMat,
+     "Textile reinforcement (carbon, AR glass), linear elastic to rupture, for `reinforcement` inside a layer."),
     ("[[layers]]", schema.LayerDef, "Layers, from the reference face outward."),
+    ("reinforcement = [{...}] (layer)", schema.ReinforcementDef,
+     "A sheet of bars or textile yarns inside a layer, bonded to it: a uniaxial material at a height above the "
+     "layer's bottom face, with its area per unit width along a direction."),
     ("[imperfection]", schema.ImperfectionDef,
      "Optional: a geometric imperfection, moving the mesh nodes along the reference face's normal before the "
      "analysis (a buckling mode of `layershell buckle`, or a formula)."),

@@ -45,7 +45,7 @@ from .newton import (FRICTION_STAGNATION, MAX_REFREEZE, RELAX_AFTER_CUTS, Active
                      cohesive_hint, contact_hint, contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze,
                      friction_acts, newton, reaction_scale, record_scale, relax, resolve, stabilise, stagnates,
                      start_inertia)
-from .problem import Problem
+from .problem import Problem, commit_state
 
 
 #: default [steps] energy_tolerance (see :func:`increment_energy_error`)
@@ -1028,7 +1028,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
             st.size *= 0.5
         # accepted increment
-        problem.commit(att.u)
+        commit_state(problem, att.u)
         du = att.u - u
         dlam = att.lam - lam
         conj = conjugates(problem, att.u) if displacement_path else None  # (v, R) at the new state

@@ -20,7 +20,7 @@ from typing import Callable, Iterator
 import numpy as np
 
 from . import linear
-from .problem import Problem
+from .problem import Problem, commit_state
 
 
 @dataclass
@@ -751,7 +751,7 @@ def load_steps(
                     continue
             if res.converged:
                 u, lam = u_new, trial
-                problem.commit(u)
+                commit_state(problem, u)
                 if trial == target:
                     break
                 inc = min(inc, target - lam) if inc > 0 else max(inc, target - lam)
@@ -771,7 +771,7 @@ def load_steps(
                     total_it += rel.iterations
                     residuals += rel.residuals
                     u, lam = rel.u, trial
-                    problem.commit(u)
+                    commit_state(problem, u)
                     halved, bis = halved + bis, 0
                     if trial == target:
                         break
@@ -796,7 +796,7 @@ def load_steps(
                     raise reequilibration_error(problem, n, lam, res)
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         prev_target = target
-        problem.commit(u)  # (again where the interfaces' update re-solved the step)
+        commit_state(problem, u)  # (again where the interfaces' update re-solved the step)
         yield StepResult(n, lam, u.copy(), total_it, residuals, bis + cuts + halved, time.perf_counter() - t0,
                          start_inertia(problem))
 

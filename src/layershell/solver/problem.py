@@ -188,3 +188,11 @@ class Problem:
         F = lam * self.F_scaled + self.F_const
         return F if self.F_friction is None else F + self.F_friction
 
+
+def commit_state(problem, u: np.ndarray) -> None:
+    """Commit the material state of a converged ``u`` where the problem has one (stand-ins of a
+    problem in the solver's tests have none)."""
+    commit = getattr(problem, "commit", None)
+    if commit is not None:
+        commit(u)
+
