@@ -411,6 +411,31 @@ class Assembler:
         self.model.point_states.clear()
         self.model.point_states.update(states)
 
+    def material_dissipation(self) -> float:
+        """Energy the inelastic layers and their reinforcement have dissipated (committed state):
+        Σ dissipation per volume × dV over the points (sheets: × A_s dA)."""
+        total = 0.0
+        for i, st in self.committed.items():
+            ref = self.blocks[i].ref
+            if ref.law is not None:
+                total += float(ref.law.dissipation(st.bulk) @ ref.base.dV.ravel())
+            for s, ss in zip(ref.sheets, st.sheets):
+                total += float(s.law.dissipation(ss) @ s.w.ravel())
+        return total
+
+    def material_events(self) -> dict[str, bool]:
+        """Which events the committed state has seen anywhere: ``cracking`` (concrete),
+        ``yielding`` (steel), ``rupture`` (reinforcement), from each law's ``events``."""
+        seen: dict[str, bool] = {}
+        for i, st in self.committed.items():
+            ref = self.blocks[i].ref
+            pairs = ([(ref.law, st.bulk)] if ref.law is not None else []) + list(zip((s.law for s in ref.sheets),
+                                                                                     st.sheets))
+            for law, state in pairs:
+                for name, flags in law.events(state).items():
+                    seen[name] = seen.get(name, False) or bool(np.any(flags))
+        return seen
+
     def material_state(self) -> dict[str, np.ndarray]:
         """The committed point states as plain arrays (snapshots, checkpoints)."""
         out: dict[str, np.ndarray] = {}

@@ -96,7 +96,10 @@ def _jsonable(obj):
 #: a restart once dropped them). The step history lives in steps.jsonl (older checkpoints held it as "steps").
 SUMMARY_KEYS = ("probes", "first_delamination_load_factor", "restarts", "wall_seconds", "warnings", "path_end",
                 "stabilized", "relaxations", "active_set", "linear_solves", "energy_balance_warned",
-                "peak_load_factor", "contact_moved_to_nodes", "stability", "settlements")
+                "peak_load_factor", "contact_moved_to_nodes", "stability", "settlements",
+                "first_cracking_load_factor", "first_cracking_step", "first_yield_load_factor", "first_yield_step",
+                "first_crushing_load_factor", "first_crushing_step", "first_rupture_load_factor",
+                "first_rupture_step")
 
 
 def capture(step: int, load_factor: float, u: np.ndarray, load_factors: np.ndarray, hash_: str,

@@ -134,6 +134,24 @@ def _zone_arrays(zones) -> dict[str, np.ndarray]:
     return out
 
 
+#: the first converged step at which an event of the inelastic layers is seen (summary.json keys)
+MATERIAL_EVENTS = {"cracking": "first_cracking_load_factor", "yielding": "first_yield_load_factor",
+                   "crushing": "first_crushing_load_factor", "rupture": "first_rupture_load_factor"}
+
+
+def _material_record(problem, summary: dict, rec: dict, st, log) -> None:
+    """The dissipated energy of the inelastic layers in the step record, and the first cracking,
+    yielding, crushing and rupture (load factor, step) in the summary and the log."""
+    asm = problem.assembler
+    rec["dissipated_material"] = asm.material_dissipation()
+    for name, seen in asm.material_events().items():
+        key = MATERIAL_EVENTS.get(name)
+        if key is not None and seen and summary.get(key) is None:
+            summary[key] = st.load_factor
+            summary[key.replace("load_factor", "step")] = st.step
+            log(f"step {st.step} λ = {st.load_factor:.6g}: first {name}")
+
+
 def _restore_zones(zones, extra: dict[str, np.ndarray]) -> None:
     """Inverse of :func:`_zone_arrays` (the steps before a restart stay in the zone maps)."""
     if "zones.step" not in extra:
@@ -722,6 +740,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                         for p in spec.probes}
                 rec = {"step": st.step, "load_factor": st.load_factor, "iterations": st.iterations,
                        "bisections": st.bisections, "wall_seconds": round(st.wall_seconds, 4), "probes": vals}
+                if problem.assembler.inelastic:
+                    _material_record(problem, summary, rec, st, log)
                 if stab is not None:  # the inertia of the tangent at the previous converged state (stability.py)
                     if st.negative_eigenvalues_start is not None:
                         rec["negative_eigenvalues_at_start"] = int(st.negative_eigenvalues_start)
