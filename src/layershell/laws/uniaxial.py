@@ -86,15 +86,16 @@ class SteelLaw:
         s_p = s_tr - E * dgam * sg
         Et = np.where(dgam > 0, E * H / (E + H), E)
         e_max = np.maximum(committed.eps_max, np.abs(eps))
-        om_c, om, dom = self._rupture(committed.eps_max), *self._rupture(e_max, with_slope=True)
+        om_c, _ = self._rupture(committed.eps_max)
+        om, dom = self._rupture(e_max)
         dom = dom * (np.abs(eps) > committed.eps_max) * np.sign(eps)
         psi = 0.5 * E * (eps - eps_p) ** 2 + (0.5 * alpha ** 2 / H if H > 0 else 0.0)
-        diss = committed.diss + (1.0 - om) * self.f_y * dgam + psi * (om - om_c[0])
+        diss = committed.diss + (1.0 - om) * self.f_y * dgam + psi * (om - om_c)
         trial = SteelState(eps_p, alpha, e_max, diss)
         sigma = (1.0 - om) * s_p
         return sigma, ((1.0 - om) * Et - s_p * dom) if tangent else None, trial
 
-    def _rupture(self, e_max, with_slope=False):
+    def _rupture(self, e_max):
         """Broken fraction ω(max |ε|) and dω/d|ε|."""
         if self.eps_u is None:
             z = np.zeros_like(e_max)
