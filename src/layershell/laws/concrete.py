@@ -230,6 +230,9 @@ class ConcreteLaw:
         n = eps.shape[0]
         h_in, h_z = np.broadcast_to(np.asarray(h_in, float), (n,)), np.broadcast_to(np.asarray(h_z, float), (n,))
         normal = np.broadcast_to(np.asarray(normal, float), (n, 3))
+        if not (np.all(h_in > 0) and np.all(h_z > 0)):
+            raise ValueError(f"concrete '{self.name}': h_in and h_z (element size and thickness-point "
+                             "spacing) must be positive at every point; pass the element's sizes")
         sbar = eps @ self.stiffness()
         w, V, P = spectral.principal(sbar)
         r_c, d_c, ddc, q, dq = self._compression(w, committed, h_in)
@@ -242,13 +245,20 @@ class ConcreteLaw:
         load_t = tau_t > committed.r_t
         r_t = np.where(load_t, tau_t, committed.r_t)
         onset = (committed.h_t <= 0) & (r_t > self.f_ct)
-        h_new, v_new, dh_row = self._band(V, w, normal, h_in, h_z)
-        h_t = np.where(onset, h_new, committed.h_t)
+        on = np.flatnonzero(onset)
+        h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], h_in[on], h_z[on])
+        h_t = committed.h_t.copy()
+        h_t[on] = h_new
         if np.any(h_t >= self.max_band()):
-            bad = int(np.argmax(h_t >= self.max_band()))
-            self.check_band(h_in[bad], h_z[bad], "(a layer of this material)")
+            i = int(np.argmax(h_t >= self.max_band()))
+            raise MaterialError(
+                f"concrete '{self.name}': a crack band h={h_t[i]:.4g} (element size h_in={h_in[i]:.4g}, "
+                f"thickness-point spacing h_z={h_z[i]:.4g}) exceeds the snap-back limit 2 G_F E / f_ct² = "
+                f"{self.max_band():.4g}; refine the mesh or use more thickness points (check_band finds "
+                "this before the analysis)")
         d_t, ddt_r, ddt_h = self.damage_tension(r_t, h_t)
-        nvec = np.where(onset[:, None], v_new, np.stack([committed.n1, committed.n2, committed.n3], -1))
+        nvec = np.stack([committed.n1, committed.n2, committed.n3], -1)
+        nvec[on] = v_new
         trial = ConcreteState(r_t, r_c, h_t, h_in.copy(), nvec[:, 0], nvec[:, 1], nvec[:, 2])
 
         wp, wn = np.maximum(w, 0.0), np.minimum(w, 0.0)
@@ -258,7 +268,7 @@ class ConcreteLaw:
             return sigma, None, trial
         g_t = ((ddt_r * load_t)[:, None] * dtau_t)
         g_t_row = np.einsum("nk,nka->na", g_t, P) * spectral.WEIGHT
-        g_t_row += (ddt_h * onset)[:, None] * dh_row
+        g_t_row[on] += ddt_h[on, None] * dh_row
         g_c_row = np.einsum("nk,nka->na", ddc, P) * spectral.WEIGHT
         M = self._split_derivative(V, w, d_t, d_c)
         sp = np.einsum("nk,nka->na", wp, P)
@@ -270,9 +280,7 @@ class ConcreteLaw:
         """d[(1 - d⁺) σ̄⁺ + (1 - d⁻) σ̄⁻]/dσ̄ at frozen damage."""
         kt, kc = 1.0 - d_t, 1.0 - d_c
         on = w > 0
-        a = np.zeros(w.shape + (3,))
-        for k in range(3):
-            a[:, k, k] = np.where(on[:, k], kt, kc)
+        a = np.where(on, kt[:, None], kc[:, None])
         theta = np.empty((w.shape[0], 3))
         for p, (i, j) in enumerate(spectral.PAIRS):
             dw = w[:, i] - w[:, j]

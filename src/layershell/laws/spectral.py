@@ -38,18 +38,18 @@ def principal(v: np.ndarray):
 
 
 def isotropic_derivative(V, a, theta):
-    """d(Σ s_k P_k)/dA as a (n, 6, 6) stress-like Voigt matrix (columns weighted by ``WEIGHT``).
+    """d(Σ s_k P_k)/dA as a (n, 6, 6) stress-like Voigt matrix (columns weighted by ``WEIGHT``) for
+    s_k depending on its own eigenvalue only.
 
-    ``a[:, i, j] = ∂s_i/∂w_j`` (n, 3, 3) and ``theta[:, p]`` the ratio (s_i - s_j)/(w_i - w_j) for the
-    pair ``PAIRS[p]`` (its equal-eigenvalue limit where w_i = w_j, supplied by the caller):
-    dF = Σ_ij a_ij P_i (P_j : dA) + Σ_(i<j) 2 θ_ij M_ij (M_ij : dA), M_ij = sym(v_i ⊗ v_j).
+    ``a[:, k] = ∂s_k/∂w_k`` (n, 3) and ``theta[:, p]`` the ratio (s_i - s_j)/(w_i - w_j) for the pair
+    ``PAIRS[p]`` (its equal-eigenvalue limit where w_i = w_j, supplied by the caller):
+    dF = Σ_k a_k P_k (P_k : dA) + Σ_(i<j) 2 θ_ij M_ij (M_ij : dA), M_ij = sym(v_i ⊗ v_j), i.e.
+    Bᵀ diag(a, θ) B in the orthonormal basis B = (P_1, P_2, P_3, √2 M_12, √2 M_13, √2 M_23).
     """
-    P = np.stack([dyad(V[:, :, k], V[:, :, k]) for k in range(3)], axis=1)
-    M = np.einsum("nki,nkl,nlj->nij", P, a, P * WEIGHT)
-    for p, (i, j) in enumerate(PAIRS):
-        m = dyad(V[:, :, i], V[:, :, j])
-        M += 2.0 * theta[:, p, None, None] * m[:, :, None] * (m * WEIGHT)[:, None, :]
-    return M
+    B = np.stack([dyad(V[:, :, k], V[:, :, k]) for k in range(3)]
+                 + [np.sqrt(2.0) * dyad(V[:, :, i], V[:, :, j]) for i, j in PAIRS], axis=1)
+    c = np.concatenate([a, theta], axis=1)
+    return np.matmul(np.swapaxes(B, 1, 2) * c[:, None, :], B * WEIGHT)
 
 
 def eigvec_derivative_row(V, w, k, c):
