@@ -1,0 +1,324 @@
+"""Concrete: bi-scalar tension/compression damage on the effective stress with a spectral split.
+
+Formulation (Faria, Oliver & Cervera 1998; Wu, Li & Faria 2006; the damage part of OpenSees
+ASDConcrete3D), without plastic strain, explicit in the strain (no local iteration):
+
+* effective stress σ̄ = C0 : ε (isotropic E, ν), split into its positive and negative principal
+  parts σ̄ = σ̄⁺ + σ̄⁻; nominal stress σ = (1 - d⁺) σ̄⁺ + (1 - d⁻) σ̄⁻ (a closing crack carries
+  compression with the full stiffness: the unilateral effect);
+* compression equivalent stress τ⁻ = (α Ī1⁻ + √(3 J̄2⁻)) / (1 - α), α = (k_b - 1)/(2 k_b - 1), from
+  the invariants of σ̄⁻ (Lubliner's criterion without its tension term);
+* tension equivalent stress τ⁺ = ⟨σ̄_max⟩ / (1 - κ q⁻/f_c), q⁻ = (1 - d⁻) τ⁻ the nominal
+  compression equivalent stress, κ = ``KAPPA_TC``: the cracking threshold f_ct falls linearly with
+  the compression acting across the crack. In plane stress this is Kupfer & Gerstle's (1973)
+  tension-compression line σ_t = f_ct (1 - κ σ_c/f_c) through the data of Kupfer, Hilsdorf & Rüsch
+  (1969); biaxial tension cracks at f_ct as measured. As a quotient (not a sum) the compression
+  scales the whole tensile branch: after onset the tension softens at any compression, and τ⁺ is
+  continuous (0 where σ̄_max ≤ 0; q⁻ ≤ f_c keeps the divisor ≥ 1 - κ > 0);
+* histories r± = max(r±_committed, τ±); d⁺(r⁺) linear to f_ct, then exponential (Oliver 1989) with
+  A = 1/(G_F E/(h f_ct²) - 1/2) so uniaxial tension dissipates G_F per crack area over the band h;
+  d⁻(r⁻) the fib MC2010 (5.1-26) Sargin curve σ = f_c (kη - η²)/(1 + (k - 2)η), η = ε/ε_c1,
+  k = E ε_c1/f_c, read as a secant damage, then σ = f_c exp(-(ε - ε_c1) h f_c/G_c) beyond the peak
+  (area under the post-peak branch × h = G_c).
+
+Crack band: fixed when a point first cracks, h = h_in sin θ + h_z |cos θ| with θ between the crack
+normal (principal direction of σ̄_max at onset) and the shell normal. Crushing uses h_in: it
+localises across an in-plane element length (compression normal to the mid-surface is not a
+shell's failure mode).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from layershell.laws import spectral
+from layershell.laws.state import PointState
+from layershell.material import MaterialError
+
+KAPPA_TC = 0.8  # tension-compression slope of Kupfer & Gerstle (1973), J. Eng. Mech. Div. 99(4), 853-866
+# fib Model Code 2010 Table 5.1-8: strain at peak stress ε_c1 (‰) per characteristic strength f_ck (MPa)
+MC2010_EPS_C1 = ((12, 1.8), (16, 1.9), (20, 2.1), (25, 2.2), (30, 2.3), (35, 2.3), (40, 2.4), (45, 2.5),
+                 (50, 2.6), (55, 2.6), (60, 2.7), (70, 2.7), (80, 2.8), (90, 2.8), (100, 3.0), (120, 3.0))
+NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
+
+
+@dataclass(frozen=True)
+class ConcreteState(PointState):
+    """r_t, r_c: tension/compression histories; h_t: crack band (0 = uncracked); h_c: crushing band;
+    n1, n2, n3: crack normal fixed at onset (zero while uncracked)."""
+
+    r_t: np.ndarray
+    r_c: np.ndarray
+    h_t: np.ndarray
+    h_c: np.ndarray
+    n1: np.ndarray
+    n2: np.ndarray
+    n3: np.ndarray
+
+
+def _x_minus_log1p_rest(x):
+    """g(x) = (x - log(1 + x) - x²/2)/x³, a series near 0 where the difference cancels."""
+    x = np.asarray(x, float)
+    small = np.abs(x) < 0.1
+    xs = np.where(small, 0.0, x)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        exact = (xs - np.log1p(xs) - 0.5 * xs * xs) / xs ** 3
+    series = sum((-1.0) ** (m + 1) * x ** m / (m + 3) for m in range(16))
+    return np.where(small, series, exact)
+
+
+@dataclass(frozen=True)
+class ConcreteLaw:
+    """Damage law of plain concrete (module docstring); SI-consistent model units throughout."""
+
+    E: float
+    nu: float
+    f_c: float
+    f_ct: float
+    G_F: float
+    G_c: float
+    eps_c1: float
+    k_b: float = 1.16
+    name: str = "concrete"
+
+    # -- construction --------------------------------------------------------------------------
+    @classmethod
+    def from_class(cls, f_ck: float, stress_unit: float = 1.0, length_unit: float = 1.0, **overrides):
+        """fib Model Code 2010 mean values from the characteristic strength ``f_ck`` (MPa).
+
+        f_cm = f_ck + 8 (5.1-1); f_ctm = 0.3 f_ck^(2/3) up to C50, 2.12 ln(1 + 0.1 f_cm) above (5.1-3a/b);
+        E_ci = 21.5e3 (f_cm/10)^(1/3) MPa, quartzite aggregate (5.1-21); G_F = 73 f_cm^0.18 N/m (5.1-9);
+        ε_c1 from Table 5.1-8 (linear between classes); ν = 0.2 (5.1.7.3); G_c = 8.8 √f_cm N/mm
+        (Nakamura & Higai 2001). ``stress_unit``: MPa per model stress unit (N, mm: 1; kN, m: 1e-3);
+        ``length_unit``: m per model length unit (mm: 1e-3). Returned in model units; ``overrides``
+        (model units) replace any field.
+        """
+        if not f_ck > 0:
+            raise MaterialError(f"concrete class: f_ck={f_ck} MPa must be positive (e.g. 30 for C30/37)")
+        f_cm = f_ck + 8.0
+        f_ctm = 0.3 * f_ck ** (2 / 3) if f_ck <= 50 else 2.12 * np.log(1 + 0.1 * f_cm)
+        E_ci = 21.5e3 * (f_cm / 10.0) ** (1 / 3)
+        G_F = 73.0 * f_cm ** 0.18 * 1e-6  # N/m -> MPa m
+        G_c = NAKAMURA_HIGAI * float(np.sqrt(f_cm)) * 1e-3  # N/mm -> MPa m
+        cls_fck, cls_eps = np.array(MC2010_EPS_C1, float).T
+        eps_c1 = float(np.interp(f_ck, cls_fck, cls_eps)) * 1e-3
+        s, e = float(stress_unit), float(stress_unit) * float(length_unit)
+        vals = dict(E=E_ci / s, nu=0.2, f_c=f_cm / s, f_ct=f_ctm / s, G_F=G_F / e, G_c=G_c / e, eps_c1=eps_c1)
+        vals.update(overrides)
+        law = cls(**vals)
+        law.check()
+        return law
+
+    def check(self) -> None:
+        """Raise :class:`MaterialError` naming the field and the fix for inadmissible constants."""
+        for k in ("E", "f_c", "f_ct", "G_F", "G_c", "eps_c1"):
+            if not getattr(self, k) > 0:
+                raise MaterialError(f"concrete '{self.name}': {k}={getattr(self, k)} must be positive; give "
+                                    f"{k} in model units or use ConcreteLaw.from_class(f_ck)")
+        if not 0.0 <= self.nu < 0.5:
+            raise MaterialError(f"concrete '{self.name}': nu={self.nu} must lie in [0, 0.5); concrete has "
+                                "nu = 0.2 (fib MC2010 5.1.7.3)")
+        if not self.eps_c1 > self.f_c / self.E:
+            raise MaterialError(f"concrete '{self.name}': eps_c1={self.eps_c1} must exceed f_c/E="
+                                f"{self.f_c / self.E:.4g} (no hardening branch below the peak otherwise); "
+                                "raise eps_c1 (about 0.002-0.003) or E")
+        if not self.k_b >= 1.0:
+            raise MaterialError(f"concrete '{self.name}': k_b={self.k_b} (biaxial/uniaxial compressive "
+                                "strength) must be at least 1; Kupfer's value is 1.16")
+
+    def max_band(self) -> float:
+        """Largest crack band without snap-back in tension: 2 G_F E / f_ct²."""
+        return 2.0 * self.G_F * self.E / self.f_ct ** 2
+
+    def check_band(self, h_in, h_z, name: str) -> None:
+        """Raise :class:`MaterialError` if a crack band h = h_in sin θ + h_z |cos θ| ≤ √(h_in² + h_z²)
+        can reach :meth:`max_band` (the exponential softening would need snap-back)."""
+        h = np.sqrt(np.asarray(h_in, float) ** 2 + np.asarray(h_z, float) ** 2)
+        if np.any(h >= self.max_band()):
+            raise MaterialError(
+                f"layer '{name}' (concrete '{self.name}'): the element size h_in={np.max(h_in):.4g} with "
+                f"thickness-point spacing h_z={np.max(h_z):.4g} gives crack bands up to {np.max(h):.4g}, "
+                f"beyond the snap-back limit 2 G_F E / f_ct² = {self.max_band():.4g}; refine the mesh "
+                "(smaller elements) or use more thickness points in this layer")
+
+    def state(self, n: int) -> ConcreteState:
+        """Virgin committed state of ``n`` points."""
+        z = np.zeros(n)
+        return ConcreteState(np.full(n, self.f_ct), z, z, z, z, z, z)
+
+    # -- elasticity and damage functions --------------------------------------------------------
+    def stiffness(self) -> np.ndarray:
+        """Undamaged 6 × 6 Voigt stiffness C0 (engineering shear strains)."""
+        lam = self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
+        mu = self.E / (2 * (1 + self.nu))
+        c = np.zeros((6, 6))
+        c[:3, :3] = lam
+        c[[0, 1, 2], [0, 1, 2]] += 2 * mu
+        c[[3, 4, 5], [3, 4, 5]] = mu
+        return c
+
+    def _tension_A(self, h):
+        """Oliver's softening parameter A(h) and dA/dh (h > 0)."""
+        K = self.G_F * self.E / self.f_ct ** 2
+        A = 1.0 / (K / h - 0.5)
+        return A, A * A * K / (h * h)
+
+    def damage_tension(self, r, h):
+        """d⁺(r; h), ∂d⁺/∂r, ∂d⁺/∂h."""
+        r0 = self.f_ct
+        hs = np.where(h > 0, h, 1.0)
+        A, dA = self._tension_A(hs)
+        x = np.maximum(r / r0, 1.0)
+        e = np.exp(A * (1.0 - x))
+        on = r > r0
+        d = np.where(on, 1.0 - e / x, 0.0)
+        dr = np.where(on, e / (x * r0) * (1.0 / x + A), 0.0)
+        dh = np.where(on & (h > 0), e / x * (x - 1.0) * dA, 0.0)
+        return d, dr, dh
+
+    def damage_compression(self, r, h):
+        """d⁻(r; h) and ∂d⁻/∂r (Sargin secant to the peak E ε_c1, exponential beyond)."""
+        rp, k = self.E * self.eps_c1, self.E * self.eps_c1 / self.f_c
+        eta = np.clip(r / rp, 0.0, 1.0)
+        den = 1.0 + (k - 2.0) * eta
+        keep_pre = (k - eta) / (k * den)
+        dpre = (k - 1.0) ** 2 / (k * den * den) / rp
+        inv_es = np.where(h > 0, h, 1.0) * self.f_c / self.G_c  # 1/ε_s
+        rs = np.maximum(r, rp)
+        sig = self.f_c * np.exp(-(rs / self.E - self.eps_c1) * inv_es)
+        keep_post = sig / rs
+        dpost = sig / rs ** 2 + keep_post * inv_es / self.E
+        post = r > rp
+        return 1.0 - np.where(post, keep_post, keep_pre), np.where(post, dpost, dpre)
+
+    # -- response -------------------------------------------------------------------------------
+    def _compression(self, w, committed, h_c):
+        """τ⁻, r⁻, d⁻, the nominal equivalent q⁻ and the derivatives dd⁻/dw, dq⁻/dw (n, 3)."""
+        a = (self.k_b - 1.0) / (2.0 * self.k_b - 1.0)
+        m = np.minimum(w, 0.0)
+        i1 = m.sum(1)
+        dev = m - i1[:, None] / 3.0
+        s3j2 = np.sqrt(1.5 * np.sum(dev * dev, 1))
+        tau = (a * i1 + s3j2) / (1 - a)
+        dtau = (a + 1.5 * dev / np.where(s3j2 > 0, s3j2, 1.0)[:, None] * (s3j2 > 0)[:, None]) / (1 - a)
+        dtau = dtau * (w < 0)
+        load = tau > committed.r_c
+        r = np.where(load, tau, committed.r_c)
+        d, dd = self.damage_compression(r, h_c)
+        ddw = (dd * load)[:, None] * dtau
+        q = (1.0 - d) * np.maximum(tau, 0.0)
+        dq = ((1.0 - d) * (tau > 0))[:, None] * dtau - np.maximum(tau, 0.0)[:, None] * ddw
+        return r, d, ddw, q, dq
+
+    def _band(self, V, w, normal, h_in, h_z):
+        """Crack band from the principal direction of σ̄_max, and the row r with r @ dσ̄ = dh."""
+        v = V[:, :, 2]
+        c = np.einsum("ni,ni->n", normal, v)
+        s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
+        h = h_in * s + h_z * np.abs(c)
+        dh_dc = -h_in * c / np.where(s > 0, s, 1.0) + h_z * np.sign(c)
+        return h, v, dh_dc[:, None] * spectral.eigvec_derivative_row(V, w, 2, normal)
+
+    def response(self, eps, committed: ConcreteState, h_in, h_z, normal, tangent: bool = True):
+        """Stress (n, 6), consistent tangent dσ/dε (n, 6, 6) or None, and the trial state.
+
+        ``eps`` (n, 6) Voigt strains with engineering shears; ``h_in``, ``h_z`` (n,) element size and
+        thickness-point spacing; ``normal`` (n, 3) unit shell normal. ``committed`` is not modified.
+        """
+        eps = np.atleast_2d(np.asarray(eps, float))
+        n = eps.shape[0]
+        h_in, h_z = np.broadcast_to(np.asarray(h_in, float), (n,)), np.broadcast_to(np.asarray(h_z, float), (n,))
+        normal = np.broadcast_to(np.asarray(normal, float), (n, 3))
+        if not (np.all(h_in > 0) and np.all(h_z > 0)):
+            raise ValueError(f"concrete '{self.name}': h_in and h_z (element size and thickness-point "
+                             "spacing) must be positive at every point; pass the element's sizes")
+        sbar = eps @ self.stiffness()
+        w, V, P = spectral.principal(sbar)
+        r_c, d_c, ddc, q, dq = self._compression(w, committed, h_in)
+
+        pos = w[:, 2] > 0
+        rho = 1.0 - KAPPA_TC * q / self.f_c
+        tau_t = np.where(pos, w[:, 2], 0.0) / rho
+        dtau_t = (tau_t * KAPPA_TC / (self.f_c * rho))[:, None] * dq
+        dtau_t[:, 2] += pos / rho
+        load_t = tau_t > committed.r_t
+        r_t = np.where(load_t, tau_t, committed.r_t)
+        onset = (committed.h_t <= 0) & (r_t > self.f_ct)
+        on = np.flatnonzero(onset)
+        h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], h_in[on], h_z[on])
+        h_t = committed.h_t.copy()
+        h_t[on] = h_new
+        if np.any(h_t >= self.max_band()):
+            i = int(np.argmax(h_t >= self.max_band()))
+            raise MaterialError(
+                f"concrete '{self.name}': a crack band h={h_t[i]:.4g} (element size h_in={h_in[i]:.4g}, "
+                f"thickness-point spacing h_z={h_z[i]:.4g}) exceeds the snap-back limit 2 G_F E / f_ct² = "
+                f"{self.max_band():.4g}; refine the mesh or use more thickness points (check_band finds "
+                "this before the analysis)")
+        d_t, ddt_r, ddt_h = self.damage_tension(r_t, h_t)
+        nvec = np.stack([committed.n1, committed.n2, committed.n3], -1)
+        nvec[on] = v_new
+        trial = ConcreteState(r_t, r_c, h_t, h_in.copy(), nvec[:, 0], nvec[:, 1], nvec[:, 2])
+
+        wp, wn = np.maximum(w, 0.0), np.minimum(w, 0.0)
+        s = (1.0 - d_t)[:, None] * wp + (1.0 - d_c)[:, None] * wn
+        sigma = np.einsum("nk,nka->na", s, P)
+        if not tangent:
+            return sigma, None, trial
+        g_t = ((ddt_r * load_t)[:, None] * dtau_t)
+        g_t_row = np.einsum("nk,nka->na", g_t, P) * spectral.WEIGHT
+        g_t_row[on] += ddt_h[on, None] * dh_row
+        g_c_row = np.einsum("nk,nka->na", ddc, P) * spectral.WEIGHT
+        M = self._split_derivative(V, w, d_t, d_c)
+        sp = np.einsum("nk,nka->na", wp, P)
+        M -= sp[:, :, None] * g_t_row[:, None, :] + (sbar - sp)[:, :, None] * g_c_row[:, None, :]
+        return sigma, M @ self.stiffness(), trial
+
+    @staticmethod
+    def _split_derivative(V, w, d_t, d_c):
+        """d[(1 - d⁺) σ̄⁺ + (1 - d⁻) σ̄⁻]/dσ̄ at frozen damage."""
+        kt, kc = 1.0 - d_t, 1.0 - d_c
+        on = w > 0
+        a = np.where(on, kt[:, None], kc[:, None])
+        theta = np.empty((w.shape[0], 3))
+        for p, (i, j) in enumerate(spectral.PAIRS):
+            dw = w[:, i] - w[:, j]
+            dp = np.maximum(w[:, i], 0) - np.maximum(w[:, j], 0)
+            phi = np.where(on[:, i] & on[:, j], 1.0,
+                           np.where(~on[:, i] & ~on[:, j], 0.0, dp / np.where(dw != 0, dw, 1.0)))
+            theta[:, p] = kt * phi + kc * (1.0 - phi)
+        return spectral.isotropic_derivative(V, a, theta)
+
+    # -- post-processing ------------------------------------------------------------------------
+    def dissipation(self, state: ConcreteState) -> np.ndarray:
+        """Energy dissipated per unit volume, per point: the uniaxial-path values of both histories
+        (exact on uniaxial paths; on others the energy of the uniaxial path with the same damage)."""
+        return self._dissipation_tension(state.r_t, state.h_t) + self._dissipation_compression(state.r_c, state.h_c)
+
+    def _dissipation_tension(self, r, h):
+        r0 = self.f_ct
+        A, _ = self._tension_A(np.where(h > 0, h, 1.0))
+        x = np.maximum(r / r0, 1.0)
+        e = np.exp(A * (1.0 - x))
+        return np.where(r > r0, r0 * r0 / self.E * (0.5 + (1.0 - e) / A - 0.5 * x * e), 0.0)
+
+    def _dissipation_compression(self, r, h):
+        rp, k = self.E * self.eps_c1, self.E * self.eps_c1 / self.f_c
+        c = k - 2.0
+        eta = np.clip(r / rp, 0.0, 1.0)
+        work = self.f_c * self.eps_c1 * (0.5 * k * eta ** 2 + (k * c + 1.0) * eta ** 3 * _x_minus_log1p_rest(c * eta))
+        es = self.G_c / (np.where(h > 0, h, 1.0) * self.f_c)
+        beyond = np.maximum(r / self.E - self.eps_c1, 0.0)
+        work = work + self.f_c * es * (1.0 - np.exp(-beyond / es))
+        d, _ = self.damage_compression(r, h)
+        return np.maximum(work - 0.5 * (1.0 - d) * r * r / self.E, 0.0)
+
+    def crack(self, eps, state: ConcreteState):
+        """Crack width (n,) = d⁺ ⟨n·ε·n⟩ × band (the inelastic normal strain over the band) and the
+        crack normal (n, 3) fixed at onset (zeros where uncracked)."""
+        eps = np.atleast_2d(np.asarray(eps, float))
+        nv = np.stack([state.n1, state.n2, state.n3], -1)
+        e_nn = np.einsum("na,na->n", spectral.dyad(nv, nv) * spectral.WEIGHT, eps * [1, 1, 1, 0.5, 0.5, 0.5])
+        d, _, _ = self.damage_tension(state.r_t, state.h_t)
+        return d * np.maximum(e_nn, 0.0) * state.h_t, nv
