@@ -291,6 +291,10 @@ class ConcreteLaw:
         return spectral.isotropic_derivative(V, a, theta)
 
     # -- post-processing ------------------------------------------------------------------------
+    def events(self, state: ConcreteState) -> dict[str, np.ndarray]:
+        """Per point: cracked (a crack band is set) and crushed (past the compressive peak)."""
+        return {"cracking": state.h_t > 0, "crushing": state.r_c > self.E * self.eps_c1}
+
     def dissipation(self, state: ConcreteState) -> np.ndarray:
         """Energy dissipated per unit volume, per point: the uniaxial-path values of both histories
         (exact on uniaxial paths; on others the energy of the uniaxial path with the same damage)."""

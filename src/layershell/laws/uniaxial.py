@@ -104,6 +104,13 @@ class SteelLaw:
         om = np.clip((e_max - self.eps_u) / span, 0.0, 1.0)
         return om, ((e_max > self.eps_u) & (e_max < self.eps_u + span)) / span
 
+    def events(self, state: SteelState) -> dict[str, np.ndarray]:
+        """Per point: yielded (a plastic strain) and ruptured (past eps_u)."""
+        out = {"yielding": state.eps_p != 0.0}
+        if self.eps_u is not None:
+            out["rupture"] = state.eps_max >= self.eps_u
+        return out
+
     def dissipation(self, state: SteelState) -> np.ndarray:
         """Energy dissipated per unit volume: f_y |dε_p| summed (exact for linear kinematic hardening)
         plus the energy released by rupture (accumulated per step)."""
@@ -168,6 +175,10 @@ class TextileLaw:
         sigma = np.where(pos, np.where(load, s_env, sec * eps), 0.0)
         Et = np.where(pos, np.where(load, ds_env, sec), 0.0)
         return sigma, Et if tangent else None, TextileState(kappa)
+
+    def events(self, state: TextileState) -> dict[str, np.ndarray]:
+        """Per point: ruptured (strained beyond f_t/E)."""
+        return {"rupture": state.kappa > self.f_t / self.E}
 
     def dissipation(self, state: TextileState) -> np.ndarray:
         """Energy dissipated per unit volume: ∫ envelope - the energy stored at the secant."""
