@@ -83,6 +83,11 @@ class Concrete:
         if self.tension == "softening" and not (self.eps_tu or 0) > self.f_ct / self.E_c:
             raise MaterialError("'eps_tu' must exceed the cracking strain f_ct/E_c for "
                                 "tension = 'softening'; give the strain at which tension ends")
+        k = self.E_c * self.eps_c1 / self.f_c
+        if self.curve == "sargin" and 1.0 + (k - 2.0) * self.eps_cu / self.eps_c1 <= 0.0:
+            raise MaterialError(f"Sargin's law is singular before eps_cu: k = E_c eps_c1/f_c = "
+                                f"{k:.3g} is too small; give the initial modulus E_ci as 'E_c' "
+                                "or a smaller 'eps_cu'")
         if self.curve == "parabola-rectangle" and self.eps_c2 > self.eps_cu:
             raise MaterialError("'eps_c2' must not exceed 'eps_cu' (EN 1992-1-1 Table 3.1)")
 
