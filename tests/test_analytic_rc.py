@@ -232,6 +232,11 @@ def test_strengthened_transformed_sections_by_hand():
     assert TRC.t_f * 1000 == pytest.approx(164.6, rel=1e-3)
     assert x == pytest.approx(28.05, rel=1e-3)
     assert EI2 == pytest.approx(E_C * 52.87e6, rel=1e-3)
+    # first yield, linear concrete: κ_y = 0.0025/(130 − 28.05) = 2.452e-5 /mm, the textile at
+    # κ_y (165 − 28.05) = 3.36 ‰ (772 MPa), M_y = EI_II κ_y = 43.48 kNm/m (1.81 × the bare strip)
+    M_y, k_y = yield_moment(strip(curve="linear", tension="none", strengthening=TRC, fibres=4000))
+    assert k_y == pytest.approx(2.452e-5, rel=1e-3)
+    assert M_y == pytest.approx(43.48e6, rel=1e-3)
 
 
 def test_moment_at_a_strengthening_strain_on_the_linear_section():
