@@ -239,6 +239,28 @@ def test_strengthened_transformed_sections_by_hand():
     assert M_y == pytest.approx(43.48e6, rel=1e-3)
 
 
+def test_trc_matrix_in_the_uncracked_section_and_its_cracking():
+    """The TRC's 10 mm matrix (E_m = 34 000 as the package's thesis TRC, f_ct,m = 2.90) with the
+    textile at its mid-depth: α_m = 34 000/33 540 = 1.0137; transformed areas and centroids
+    160 000 @ 80, 10 137 @ 165 (own I 84 480), 2341.7 @ 130, 1128.8 @ 165: A = 173 608 mm²,
+    z̄ = 86.19 mm, I_I = 422.0e6 mm⁴ (EI_I = 14 154 kNm²/m). The concrete soffit would crack
+    at 2.90 I_I/(160 − z̄) = 16.58 kNm/m, the matrix's bottom face first, at
+    2.90 I_I/(α_m (170 − z̄)) = 14.41 kNm/m. The fibre model (linear compression) follows
+    EI_I up to there and drops past it; in state II the matrix carries nothing."""
+    matrix = Concrete(f_c=60.0, f_ct=F_CT, E_c=34000.0, curve="linear")
+    trc = Strengthening(t_f=TRC.t_f, E_f=230e3, f_fu=2500.0, matrix=matrix, t_m=10.0)
+    sec = strip(curve="linear", strengthening=trc, fibres=16000)
+    assert sec.strengthening_depth == 165.0
+    Mcr, EI1 = cracking_moment(sec)
+    assert EI1 == pytest.approx(14.154e12, rel=1e-3)
+    assert Mcr == pytest.approx(14.41e6, rel=1e-3)
+    k_cr = Mcr / EI1
+    st = moment_curvature(sec, [0.5 * k_cr, 0.999 * k_cr, 1.01 * k_cr])
+    assert st.M[:2] == pytest.approx(EI1 * st.kappa[:2], rel=1e-4)
+    assert st.M[2] < st.M[1]
+    assert cracked_stiffness(sec) == pytest.approx(cracked_stiffness(strip(strengthening=TRC)))
+
+
 def test_moment_at_a_strengthening_strain_on_the_linear_section():
     """Linear, no tension: the layer's strain ε at depth z_f is κ (z_f − x_II), so
     M = EI_II ε/(z_f − x_II)."""
@@ -317,6 +339,11 @@ def test_said_wu_by_hand():
     (lambda: RCSection(h=100.0, b=1000.0, concrete=Concrete(30.0, 2.9, 3e4),
                        rebars=(Rebar(depth=120.0, area=300.0),)), "outside"),
     (lambda: moment_curvature(strip(), [-1e-5]), "≥ 0"),
+    (lambda: Strengthening(t_f=0.2, E_f=230e3, f_fu=2500.0, t_m=10.0), "matrix"),
+    (lambda: strip(strengthening=Strengthening(t_f=0.2, E_f=230e3, f_fu=2500.0, depth=175.0,
+                                               matrix=Concrete(60.0, 3.0, 3e4, curve="linear"),
+                                               t_m=10.0)),
+     "inside the TRC"),
     (lambda: ic.width_factor(200.0, 100.0), "b_f"),
     (lambda: ic.teng_ic_strain(38.0, 230e3, -1.0, 50.0, 100.0), "t_f"),
     (lambda: ic.section_debonding_strain(strip(strengthening=TRC), "sika"), "not known"),

@@ -5,7 +5,10 @@ uncracked and fully cracked flexural stiffness.
 
 Geometry: depth z measured down from the top face, the concrete occupies 0 ≤ z ≤ h with width b;
 reinforcement layers are points at depth d_i with area A_i; the strengthening layer is a point at
-its centroid depth (default h + t_f/2) with area b_f t_f. Plane sections, perfect bond: the
+its centroid depth (default h + t_f/2) with area b_f t_f. A TRC layer may add its cementitious
+matrix: a second concrete of thickness t_m below the soffit (h ≤ z ≤ h + t_m, width b_f) with its
+own law, integrated like the section's concrete; the textile then lies inside it (default
+depth h + t_m/2). Plane sections, perfect bond: the
 strain is ε(z) = κ (z − x) with κ > 0 sagging (top in compression) and x the neutral axis depth;
 strains and stresses are positive in tension. Any consistent units (N, mm, MPa in the tests).
 
@@ -40,6 +43,8 @@ from layershell.material import MaterialError
 
 #: fewest concrete fibres accepted: the brittle tension drop is resolved to f_ct b h / fibres
 MIN_FIBRES = 200
+#: fewest fibres across a TRC matrix (its thickness is a small fraction of h)
+MIN_MATRIX_FIBRES = 20
 #: relative tolerance of the neutral-axis root (to the section depth)
 X_TOL = 1e-13
 #: curvatures scanned (× 1/h) to bracket a limit state: from far below cracking to far past failure
@@ -152,18 +157,26 @@ class Rebar:
 class Strengthening:
     """A bonded linear-elastic layer at the soffit: thickness t_f (for a textile, its fibre area
     per width), modulus E_f, rupture stress f_fu, width b_f (default: the section's), centroid
-    ``depth`` (default h + t_f/2)."""
+    ``depth`` (default h + t_f/2, or h + t_m/2 with a matrix); optionally the TRC ``matrix``
+    concrete of thickness ``t_m`` that embeds it."""
 
     t_f: float
     E_f: float
     f_fu: float
     b_f: float | None = None
     depth: float | None = None
+    matrix: Concrete | None = None
+    t_m: float = 0.0
 
     def __post_init__(self):
         _positive("strengthening t_f", self.t_f, "give the layer (or equivalent) thickness")
         _positive("strengthening E_f", self.E_f, "give the layer modulus")
         _positive("strengthening f_fu", self.f_fu, "give the rupture stress")
+        if self.matrix is not None:
+            _positive("strengthening t_m", self.t_m, "give the thickness of the TRC matrix")
+        elif self.t_m != 0.0:
+            raise MaterialError("'t_m' is given without a 'matrix'; give the matrix concrete "
+                                "or leave t_m at 0")
 
     @property
     def eps_fu(self) -> float:
@@ -181,6 +194,7 @@ class RCSection:
     strengthening: Strengthening | None = None
     fibres: int = 400
     _z: np.ndarray = field(init=False, repr=False, compare=False)
+    _zm: np.ndarray = field(init=False, repr=False, compare=False)
 
     def __post_init__(self):
         _positive("h", self.h, "give the section depth")
@@ -195,8 +209,24 @@ class RCSection:
         s = self.strengthening
         if s is not None and s.depth is not None and not s.depth >= self.h:
             raise MaterialError(f"strengthening depth {s.depth} lies above the soffit h = {self.h}")
+        if s is not None and s.matrix is not None and not self.strengthening_depth <= self.h + s.t_m:
+            raise MaterialError(f"strengthening depth {s.depth} lies below its matrix (h + t_m = "
+                                f"{self.h + s.t_m}); give a depth inside the TRC layer")
         n = int(self.fibres)
         object.__setattr__(self, "_z", (np.arange(n) + 0.5) * self.h / n)
+        n_m = max(MIN_MATRIX_FIBRES, int(np.ceil(n * self.t_m / self.h)))
+        object.__setattr__(self, "_zm", self.h + (np.arange(n_m) + 0.5) * self.t_m / n_m)
+
+    @property
+    def t_m(self) -> float:
+        """Thickness of the TRC matrix below the soffit (0 without one)."""
+        s = self.strengthening
+        return 0.0 if s is None or s.matrix is None else s.t_m
+
+    @property
+    def b_f(self) -> float:
+        s = self.strengthening
+        return self.b if s is None or s.b_f is None else s.b_f
 
     # --- the point-like components: reinforcement first, then the strengthening layer ---
     @property
@@ -210,8 +240,7 @@ class RCSection:
     def point_areas(self) -> np.ndarray:
         a = [r.area for r in self.rebars]
         if self.strengthening is not None:
-            s = self.strengthening
-            a.append((self.b if s.b_f is None else s.b_f) * s.t_f)
+            a.append(self.b_f * self.strengthening.t_f)
         return np.array(a, dtype=float)
 
     @property
@@ -224,11 +253,13 @@ class RCSection:
     @property
     def strengthening_depth(self) -> float:
         s = self.strengthening
-        return self.h + s.t_f / 2 if s.depth is None else s.depth
+        if s.depth is not None:
+            return s.depth
+        return self.h + (s.t_m / 2 if s.matrix is not None else s.t_f / 2)
 
     @property
     def z_max(self) -> float:
-        return float(max([self.h, *self.point_depths]))
+        return float(max([self.h + self.t_m, *self.point_depths]))
 
     def point_stresses(self, eps: np.ndarray) -> np.ndarray:
         """Stresses of the point components for their strains (last axis: the components)."""
@@ -260,7 +291,12 @@ def _forces(sec: RCSection, kappa: float, x: float) -> tuple[float, float]:
     fc = sec.concrete.stress(kappa * (sec._z - x)) * sec.b * dz
     zp = sec.point_depths
     fp = sec.point_stresses(kappa * (zp - x)) * sec.point_areas
-    return fc.sum() + fp.sum(), fc @ sec._z + fp @ zp
+    N, M = fc.sum() + fp.sum(), fc @ sec._z + fp @ zp
+    if sec.t_m > 0.0:
+        fm = (sec.strengthening.matrix.stress(kappa * (sec._zm - x)) * sec.b_f
+              * sec.t_m / sec._zm.size)
+        N, M = N + fm.sum(), M + fm @ sec._zm
+    return N, M
 
 
 def neutral_axis(sec: RCSection, kappa: float) -> float:
@@ -325,25 +361,37 @@ def _state_at(sec: RCSection, kappa: float) -> SectionState:
 
 def cracking_moment(sec: RCSection) -> tuple[float, float]:
     """M_cr = f_ct I_I/(h − z̄) of the uncracked transformed section (every component with
-    α = E/E_c, holes not deducted), f_ct reached at the concrete soffit; and EI_I = E_c I_I."""
+    α = E/E_c, holes not deducted), f_ct reached at the concrete soffit; with a TRC matrix the
+    smaller of that and f_ct,m I_I/(α_m (h + t_m − z̄)), its bottom face cracking. And
+    EI_I = E_c I_I."""
     z_bar, I = transformed_uncracked(sec)
-    return sec.concrete.f_ct * I / (sec.h - z_bar), sec.concrete.E_c * I
+    M = sec.concrete.f_ct * I / (sec.h - z_bar)
+    if sec.t_m > 0.0:
+        m = sec.strengthening.matrix
+        alpha_m = m.E_c / sec.concrete.E_c
+        M = min(M, m.f_ct * I / (alpha_m * (sec.h + sec.t_m - z_bar)))
+    return M, sec.concrete.E_c * I
 
 
 def transformed_uncracked(sec: RCSection) -> tuple[float, float]:
     """Centroid depth z̄ and second moment I_I of the uncracked section in concrete units."""
     aA = sec.point_moduli / sec.concrete.E_c * sec.point_areas
     zp = sec.point_depths
-    A = sec.b * sec.h + aA.sum()
-    z_bar = (sec.b * sec.h**2 / 2 + aA @ zp) / A
-    I = sec.b * sec.h**3 / 12 + sec.b * sec.h * (sec.h / 2 - z_bar) ** 2 + aA @ (zp - z_bar) ** 2
+    # rectangles (area, centroid, own second moment): the concrete and the TRC matrix
+    rect = [(sec.b * sec.h, sec.h / 2, sec.b * sec.h**3 / 12)]
+    if sec.t_m > 0.0:
+        a_m = sec.strengthening.matrix.E_c / sec.concrete.E_c * sec.b_f
+        rect.append((a_m * sec.t_m, sec.h + sec.t_m / 2, a_m * sec.t_m**3 / 12))
+    A = sum(r[0] for r in rect) + aA.sum()
+    z_bar = (sum(r[0] * r[1] for r in rect) + aA @ zp) / A
+    I = sum(r[2] + r[0] * (r[1] - z_bar) ** 2 for r in rect) + aA @ (zp - z_bar) ** 2
     return z_bar, I
 
 
 def cracked_stiffness(sec: RCSection) -> tuple[float, float]:
     """State II: neutral axis x_II from b x²/2 = Σ α_i A_i (d_i − x) (linear concrete without
-    tension, every component linear with α_i = E_i/E_c), and EI_II = E_c [b x³/3 + Σ α_i A_i
-    (d_i − x)²]."""
+    tension, every component linear with α_i = E_i/E_c; a TRC matrix, in tension, carries
+    nothing), and EI_II = E_c [b x³/3 + Σ α_i A_i (d_i − x)²]."""
     aA = sec.point_moduli / sec.concrete.E_c * sec.point_areas
     zp = sec.point_depths
     # b/2 x² + (Σ αA) x − Σ αA d = 0
