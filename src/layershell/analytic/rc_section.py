@@ -209,9 +209,10 @@ class RCSection:
         s = self.strengthening
         if s is not None and s.depth is not None and not s.depth >= self.h:
             raise MaterialError(f"strengthening depth {s.depth} lies above the soffit h = {self.h}")
-        if s is not None and s.matrix is not None and not self.strengthening_depth <= self.h + s.t_m:
+        bottom = self.h + self.t_m
+        if self.t_m > 0.0 and not self.strengthening_depth <= bottom:
             raise MaterialError(f"strengthening depth {s.depth} lies below its matrix (h + t_m = "
-                                f"{self.h + s.t_m}); give a depth inside the TRC layer")
+                                f"{bottom}); give a depth inside the TRC layer")
         n = int(self.fibres)
         object.__setattr__(self, "_z", (np.arange(n) + 0.5) * self.h / n)
         n_m = max(MIN_MATRIX_FIBRES, int(np.ceil(n * self.t_m / self.h)))
