@@ -344,6 +344,8 @@ def test_said_wu_by_hand():
                                                matrix=Concrete(60.0, 3.0, 3e4, curve="linear"),
                                                t_m=10.0)),
      "inside the TRC"),
+    (lambda: moment_at_strengthening_strain(strip(strengthening=TRC), 0.0115),
+     "fails first by strengthening rupture"),
     (lambda: ic.width_factor(200.0, 100.0), "b_f"),
     (lambda: ic.teng_ic_strain(38.0, 230e3, -1.0, 50.0, 100.0), "t_f"),
     (lambda: ic.section_debonding_strain(strip(strengthening=TRC), "sika"), "not known"),

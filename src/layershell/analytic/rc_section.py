@@ -433,11 +433,16 @@ def ultimate_moment(sec: RCSection) -> tuple[float, float, str]:
 
 def moment_at_strengthening_strain(sec: RCSection, eps_f: float) -> tuple[float, float]:
     """Moment and curvature at which the strengthening layer's strain reaches ``eps_f`` (e.g.
-    an IC debonding strain), on the monotonic moment–curvature path."""
+    an IC debonding strain), on the monotonic moment–curvature path; MaterialError if the
+    section reaches its ultimate state (crushing, rupture) first."""
     if sec.strengthening is None:
         raise MaterialError("the section has no strengthening layer")
     _positive("eps_f", eps_f, "give the strain of the strengthening layer")
     limits = np.full(1 + len(sec.point_depths), np.inf)
     limits[-1] = eps_f
     k, _ = _first_crossing(sec, limits)
+    if _limit_ratio(sec, k, ultimate_limits(sec))[0].max() > 1.0 + 1e-9:
+        Mu, _, mode = ultimate_moment(sec)
+        raise MaterialError(f"the strengthening strain {eps_f:.4g} is not reached: the section "
+                            f"fails first by {mode} at M_u = {Mu:.4g}")
     return float(_state_at(sec, k).M[0]), k
