@@ -8,9 +8,9 @@ reinforcement layers are points at depth d_i with area A_i; the strengthening la
 its centroid depth (default h + t_f/2) with area b_f t_f. A TRC layer may add its cementitious
 matrix: a second concrete of thickness t_m below the soffit (h ≤ z ≤ h + t_m, width b_f) with its
 own law, integrated like the section's concrete; the textile then lies inside it (default
-depth h + t_m/2). Plane sections, perfect bond: the
-strain is ε(z) = κ (z − x) with κ > 0 sagging (top in compression) and x the neutral axis depth;
-strains and stresses are positive in tension. Any consistent units (N, mm, MPa in the tests).
+depth h + t_m/2). Plane sections, perfect bond: the strain is ε(z) = κ (z − x) with κ > 0
+sagging (top in compression) and x the neutral axis depth; strains and stresses are positive in
+tension. Any consistent units (N, mm, MPa in the tests).
 
 Concrete in compression (f_c, the strain magnitudes ε_c1, ε_c2, ε_cu given as positive numbers):
 
