@@ -45,9 +45,9 @@ def write_buckling(out_dir: Path, result: BucklingResult, info: dict, figure: bo
     names.append(MODES_FILE)
     summary = {**info, "n_dofs": int(pb.op.n_red), "n_dofs_full": int(pb.dm.n_full),
                "load_factors": [float(v) for v in result.load_factors], "modes": modes,
-               "analysis": "linear eigenvalue buckling of the bonded stack: (K0 + lambda K1) phi = 0, K1 the "
-                           "stress stiffness of the linear state at lambda = 1; the modes are scaled to a "
-                           "largest face translation of 1"}
+               "analysis": "linear eigenvalue buckling of the layer stack, bonded except the initially debonded "
+                           "zones (open, no contact): (K0 + lambda K1) phi = 0, K1 the stress stiffness of the "
+                           "linear state at lambda = 1; the modes are scaled to a largest face translation of 1"}
     (out_dir / "buckling.json").write_text(json.dumps(summary, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     with open(out_dir / "buckling.csv", "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
