@@ -22,8 +22,8 @@ bonded points are tied as in the bonded stack, points of an initially debonded z
 layers free, and no contact acts there - the linear buckling of the open delamination (contact
 would only stiffen a mode that closes the gap; an opening mode, as the local buckling of a
 sub-laminate, is unaffected). A cohesive interface's intact points are tied as well, not held
-by their penalty stiffness: the penalty approximates the tie (its default is chosen to soften
-the stack by about 2 %, ``cohesive_softening_estimate``), the tie is its exact limit, and the
+by their penalty stiffness: the penalty approximates the tie (the default softens the stack
+by at most about 2 %, ``cohesive_softening_estimate``), the tie is its exact limit, and the
 cohesive law - stiff in compression, soft in tension where damaged - is not the quadratic
 polynomial in u that the central difference for K₁ needs. Loads and prescribed displacements
 that do not scale with λ (``scaled = false``) are refused, since the buckling factor multiplies
