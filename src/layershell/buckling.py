@@ -1,4 +1,4 @@
-"""Linear (eigenvalue) buckling of the bonded layered shell.
+"""Linear (eigenvalue) buckling of the layered shell, bonded or with initial delaminations.
 
 The prestress state u₀ is the geometrically linear solution under the model's loads and
 prescribed displacements at load factor λ = 1: K₀ u₀ = F with u = T u_r + g (constraints.py).
@@ -16,9 +16,18 @@ modes φ_k solve (K₀ + λ K₁) φ = 0 in the reduced space (Tᵀ K T). They a
 eigenvalues μ = 1/λ of K₀⁻¹(−K₁) by SciPy's Lanczos (``eigsh``) with K₀ factorised once -
 shift-invert about λ = 0, so the smallest positive buckling loads converge first.
 
-Interface laws are refused: the analysis is of the bonded stack. Loads and prescribed
-displacements that do not scale with λ (``scaled = false``) are refused as well, since the
-buckling factor multiplies the whole load.
+A model with [[interfaces]] is analysed in its initial bond state, the state a run starts from
+(:meth:`Problem.build <layershell.solver.problem.Problem.build>` with its interface controller):
+bonded points are tied as in the bonded stack, points of an initially debonded zone leave both
+layers free, and no contact acts there - the linear buckling of the open delamination (contact
+would only stiffen a mode that closes the gap; an opening mode, as the local buckling of a
+sub-laminate, is unaffected). A cohesive interface's intact points are tied as well, not held
+by their penalty stiffness: the penalty approximates the tie (the default softens the stack
+by at most about 2 %, ``cohesive_softening_estimate``), the tie is its exact limit, and the
+cohesive law - stiff in compression, soft in tension where damaged - is not the quadratic
+polynomial in u that the central difference for K₁ needs. Loads and prescribed displacements
+that do not scale with λ (``scaled = false``) are refused, since the buckling factor multiplies
+the whole load.
 """
 from __future__ import annotations
 
@@ -43,15 +52,32 @@ class BucklingResult:
     load_factors: np.ndarray  # (k,) the smallest positive buckling load factors, ascending
     modes: np.ndarray  # (k, n_full) full-space modes, largest face translation +1
     prestress: np.ndarray  # (n_full,) the linear state u₀ at λ = 1
-    problem: Problem  # the bonded problem (nonlinear kinematics) the modes belong to
+    problem: Problem  # the tied problem (nonlinear kinematics, initial bond state) the modes belong to
+
+
+def initial_bond_state(problem: Problem) -> None:
+    """Turn a problem built with interface laws into the tied problem of its initial bond state:
+    the bond flags of the run's start (thesis law: bonded except the initially debonded nodes),
+    a cohesive interface tied except at its fully damaged (initially debonded) points; the
+    contact and cohesive blocks removed (no contact, no penalty)."""
+    from .solver.interface_state import CohesiveRun
+
+    for r in problem.interfaces.runs:
+        if isinstance(r, CohesiveRun):
+            cb = r.block.contact
+            free = np.zeros(problem.model.mesh.n_nodes, bool)
+            free[cb.conn[:, cb.region][r.initial]] = True
+            up, lo = cb.itf.upper, cb.itf.lower
+            problem.bonded[up] = problem.dm.present[up] & problem.dm.present[lo] & ~free
+    problem.interfaces, problem.extra_blocks, problem.F_friction = None, [], None
+    problem.assembler.add_blocks([])
+    problem.rebuild_constraints()
 
 
 def _nonlinear_problem(model: Model) -> Problem:
-    if model.interface_laws:
-        raise BucklingError("buckling analyses the bonded stack only, but the model has [[interfaces]] with "
-                            "interface laws; remove the [[interfaces]] tables for the buckling analysis (the "
-                            "layers are then bonded), or trace the delaminating model with 'layershell run'")
     problem = Problem.build(dataclasses.replace(model, nonlinear=True))
+    if problem.interfaces is not None:
+        initial_bond_state(problem)
     if problem.extra_blocks or problem.assembler.extra:
         raise BucklingError("buckling analyses the bonded layer stack without contact or spring blocks; remove "
                             "them for the buckling analysis")

@@ -1,7 +1,9 @@
 """Files of ``layershell buckle``: buckling.json and buckling.csv (the load factors), one VTU per
 mode (the reference surface with the mode's director fields, :func:`export.surface_mesh`),
 buckling_modes.npz (the modes' reference-face displacements at the nodes, read by
-``[imperfection]``) and buckling_modes.png (each mode's normal displacement over the mesh)."""
+``[imperfection]``) and buckling_modes.png (each mode's normal displacement over the mesh, on the
+layer face that moves most: the reference face, or the bottom face of a layer above it where a
+mode is local to that layer, as the sub-laminate over a delamination)."""
 from __future__ import annotations
 
 import csv
@@ -13,6 +15,9 @@ import numpy as np
 from .buckling import BucklingResult
 
 MODES_FILE = "buckling_modes.npz"
+#: the figure shows the reference face unless another face moves more than 1 / FACE_SHARE times
+#: as much (a mode local to a layer above it); near-equal faces: the reference face, as imperfections use
+FACE_SHARE = 0.5
 
 
 def normal_components(nodes: np.ndarray, elements: np.ndarray, displacement: np.ndarray) -> np.ndarray:
@@ -45,9 +50,9 @@ def write_buckling(out_dir: Path, result: BucklingResult, info: dict, figure: bo
     names.append(MODES_FILE)
     summary = {**info, "n_dofs": int(pb.op.n_red), "n_dofs_full": int(pb.dm.n_full),
                "load_factors": [float(v) for v in result.load_factors], "modes": modes,
-               "analysis": "linear eigenvalue buckling of the bonded stack: (K0 + lambda K1) phi = 0, K1 the "
-                           "stress stiffness of the linear state at lambda = 1; the modes are scaled to a "
-                           "largest face translation of 1"}
+               "analysis": "linear eigenvalue buckling of the layer stack, bonded except the initially debonded "
+                           "zones (open, no contact): (K0 + lambda K1) phi = 0, K1 the stress stiffness of the "
+                           "linear state at lambda = 1; the modes are scaled to a largest face translation of 1"}
     (out_dir / "buckling.json").write_text(json.dumps(summary, indent=2, ensure_ascii=False) + "\n", encoding="utf-8")
     with open(out_dir / "buckling.csv", "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
@@ -56,12 +61,32 @@ def write_buckling(out_dir: Path, result: BucklingResult, info: dict, figure: bo
             w.writerow([m["mode"], repr(m["load_factor"])])
     names += ["buckling.json", "buckling.csv"]
     if figure:
-        names.append(_figure(out_dir, model.mesh, ref, result.load_factors))
+        faces = [moving_face(pb, phi) for phi in result.modes]
+        names.append(_figure(out_dir, model.mesh, np.stack([f[1] for f in faces]), result.load_factors,
+                             [f[0] for f in faces]))
     return names
 
 
-def _figure(out_dir: Path, mesh, ref: np.ndarray, load_factors: np.ndarray) -> str:
-    """Each mode's normal displacement over the mesh, drawn in the plane of its two widest axes."""
+def moving_face(pb, phi: np.ndarray) -> tuple[str, np.ndarray]:
+    """The name and (n_nodes, 3) displacement of the layer bottom face (director 0, zero where
+    the layer is absent) with the largest normal displacement in mode ``phi``; 'reference face'
+    where that is the reference face's."""
+    from .export import reference_displacement
+
+    model, dm = pb.model, pb.dm
+    X, E = np.asarray(model.mesh.nodes, float), np.asarray(model.mesh.elements)
+    faces = [reference_displacement(model, dm, phi)]
+    for k in range(len(model.layers)):
+        faces.append(np.where(dm.present[k][:, None], phi[dm.layer_dofs[k][:, 0, :]], 0.0))
+    m = np.abs(normal_components(X, E, np.stack(faces))).max(axis=1)
+    best = 0 if m[0] >= FACE_SHARE * m.max() else int(np.argmax(m))
+    name = "reference face" if best == 0 else f"bottom face of layer '{model.layers[best - 1].name}'"
+    return name, faces[best]
+
+
+def _figure(out_dir: Path, mesh, ref: np.ndarray, load_factors: np.ndarray, where: list[str]) -> str:
+    """Each mode's normal displacement over the mesh (``ref``: on the face named in ``where``),
+    drawn in the plane of its two widest axes."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -82,7 +107,7 @@ def _figure(out_dir: Path, mesh, ref: np.ndarray, load_factors: np.ndarray) -> s
         top = float(np.abs(w[i]).max()) or 1.0
         c = ax.tripcolor(tri, w[i], shading="gouraud", cmap="RdBu_r", vmin=-top, vmax=top)
         ax.set_aspect("equal")
-        ax.set_title(f"mode {i + 1}: load factor {load_factors[i]:.5g}", fontsize=9)
+        ax.set_title(f"mode {i + 1}: load factor {load_factors[i]:.5g} ({where[i]})", fontsize=9)
         ax.set_xlabel("xyz"[axes[0]])
         ax.set_ylabel("xyz"[axes[1]])
         fig.colorbar(c, ax=ax, label="normal displacement")

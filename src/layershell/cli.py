@@ -455,8 +455,9 @@ def buckle(
     modes: int = typer.Option(3, "--modes", "-n", min=1, help="number of buckling modes"),
     out_dir: Path = typer.Option(None, "--out", "-o", help="results folder (default results/<model name>_buckle)"),
 ):
-    """Linear (eigenvalue) buckling of the bonded model under its loads at λ = 1: writes buckling.json,
-    buckling.csv, buckling_mode_<k>.vtu, buckling_modes.npz (for [imperfection]) and buckling_modes.png."""
+    """Linear (eigenvalue) buckling of the model under its loads at λ = 1, the layers bonded except the
+    initially debonded zones of [[interfaces]] (open, without contact): writes buckling.json, buckling.csv,
+    buckling_mode_<k>.vtu, buckling_modes.npz (for [imperfection]) and buckling_modes.png."""
     spec = _load(model)
     from .buckling import BucklingError, linear_buckling
     from .buckling_output import write_buckling
@@ -484,7 +485,8 @@ def buckle(
     if len(res.load_factors) < modes:
         err.print(f"warning: {len(res.load_factors)} of the {modes} modes asked for have a positive load factor "
                   "(the others would buckle under the reversed load)", soft_wrap=True, highlight=False)
-    out.print(f"{len(res.load_factors)} buckling mode(s) of the bonded model, {res.problem.op.n_red} unknowns — "
+    state = "with its initial delaminations open" if spec.model.interface_laws else "bonded"
+    out.print(f"{len(res.load_factors)} buckling mode(s) of the model ({state}), {res.problem.op.n_red} unknowns — "
               f"results in {out_dir}/ (buckling.json, buckling.csv, buckling_mode_*.vtu, buckling_modes.npz, "
               "buckling_modes.png)", soft_wrap=True, highlight=False)
 

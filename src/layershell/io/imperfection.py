@@ -42,8 +42,10 @@ def _mode_shape(m: meshmod.Mesh, imp, base: Path) -> np.ndarray:
     w = normal_components(m.nodes, m.elements, disp[imp.mode - 1][None])[0]
     top = float(np.abs(w).max())
     if not top > 0.0:
-        raise InputError(f"'{F}.mode': mode {imp.mode} has no displacement along the normal (an in-plane mode), so it "
-                         "gives no imperfection; choose another mode")
+        raise InputError(f"'{F}.mode': mode {imp.mode} moves the reference face not at all along its normal (an "
+                         "in-plane mode, or a mode local to a layer above a held reference face, such as a "
+                         "sub-laminate over a delamination), so it gives no imperfection of the mesh; choose "
+                         "another mode")
     return w / top
 
 
