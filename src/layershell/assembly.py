@@ -20,6 +20,11 @@ from .element.kernel import LayerBlock, layer_block, layer_response
 from .model import Model
 
 
+#: the largest IMPL-EX extrapolation ratio (next increment over the last): an increment grown
+#: more than this would extrapolate the damage rate of a short one far beyond where it held
+MAX_IMPLEX_RATIO = 4.0
+
+
 @dataclass(frozen=True)
 class Block:
     """One layer over the elements of one stack."""
@@ -385,6 +390,15 @@ class Assembler:
 
         self.committed = {i: initial_state(b.ref) for i, b in enumerate(self.blocks) if isinstance(b.ref, InelasticBlock)}
         self.trial = {i: st.copy() for i, st in self.committed.items()}
+        # IMPL-EX (element/inelastic.py): the state of the commit before and the histories
+        # extrapolated from the two; "implicit": the laws' plain update in every iteration
+        self.integration = getattr(model, "integration", "implex")
+        self.previous = {i: st.copy() for i, st in self.committed.items()}
+        self.extrapolated: dict = {}
+        # the pseudo-time of the last two commits (the solvers' load factor or increment count)
+        self.times = (0.0, 0.0)
+        self.ratio = 1.0
+        self._extrapolate()
         if not model.point_states:  # (a second assembler of the same model, e.g. for probes, keeps the first's)
             self._publish()
         self._pattern()
@@ -394,13 +408,55 @@ class Assembler:
         """Some layer has a material history (its response depends on the committed state)."""
         return bool(self.committed)
 
-    def commit(self, u_full: np.ndarray) -> None:
-        """Take the material state at ``u_full`` (a converged solution) as the committed one."""
+    def commit(self, u_full: np.ndarray, time: float | None = None) -> None:
+        """Take the material state at ``u_full`` (a converged solution) as the committed one;
+        ``time``: its pseudo-time for the IMPL-EX extrapolation (default: one more than the last)."""
         if not self.committed:
             return
         self._layers(u_full, np.zeros(self.dm.n_full), None)
+        self.previous = self.committed
         self.committed = {i: st.copy() for i, st in self.trial.items()}
+        self.times = (self.times[1], self.times[1] + 1.0 if time is None else float(time))
+        self.ratio = 1.0
+        self._extrapolate()
         self._publish()
+
+    def next_increment(self, time: float | None = None, ratio: float | None = None) -> None:
+        """The IMPL-EX extrapolation to pseudo-time ``time``, or by ``ratio`` (the next increment's
+        size over the last one's); neither: one unit."""
+        if not self.extrapolated:
+            return
+        t0, t1 = self.times
+        last = t1 - t0
+        if ratio is None:
+            ratio = 1.0 if time is None or last == 0.0 else (float(time) - t1) / last
+        ratio = min(max(ratio, 0.0), MAX_IMPLEX_RATIO)
+        if ratio != self.ratio:
+            self.ratio = ratio
+            self._extrapolate()
+
+    def implex_error(self, u_full: np.ndarray) -> float:
+        """The largest difference between the damage an IMPL-EX increment to ``u_full`` acted with
+        and the implicit update there (0 without extrapolated layers)."""
+        if not self.extrapolated:
+            return 0.0
+        self._layers(u_full, np.zeros(self.dm.n_full), None)
+        err = 0.0
+        for i, ex in self.extrapolated.items():
+            e = self.blocks[i].ref.law.implex_error(self.trial[i].bulk, ex.bulk)
+            err = max(err, float(e.max()) if e.size else 0.0)
+        return err
+
+    def _extrapolate(self) -> None:
+        from .element.inelastic import extrapolated_state
+
+        self.extrapolated = {}
+        if self.integration != "implex":
+            return
+        for i, st in self.committed.items():
+            ex = extrapolated_state(self.blocks[i].ref, self.previous[i], st, self.ratio)
+            if ex is not None:
+                self.extrapolated[i] = ex
 
     def _publish(self) -> None:
         """Hand the committed states to the model's outputs (``Model.point_states``)."""
@@ -441,13 +497,16 @@ class Assembler:
         out: dict[str, np.ndarray] = {}
         for i, st in self.committed.items():
             out.update(st.to_dict(f"block{i}"))
+            out.update(self.previous[i].to_dict(f"previous{i}"))
         return out
 
     def set_material_state(self, arrays: dict) -> None:
         """Restore the committed point states from :meth:`material_state`'s arrays (KeyError if one
         is missing or of another shape)."""
         self.committed = {i: st.load(arrays, f"block{i}") for i, st in self.committed.items()}
+        self.previous = {i: st.load(arrays, f"previous{i}") for i, st in self.previous.items()}
         self.trial = {i: st.copy() for i, st in self.committed.items()}
+        self._extrapolate()
         self._publish()
 
     def add_blocks(self, extra: list) -> None:
@@ -554,7 +613,7 @@ class Assembler:
                     from .element.inelastic import inelastic_response, put_trial
 
                     fe, Ke, tr = inelastic_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl,
-                                                    self.committed[bi])
+                                                    self.committed[bi], self.extrapolated.get(bi))
                     put_trial(self.trial[bi], b.ref, sl, tr)
                 else:
                     fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl)

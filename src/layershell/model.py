@@ -182,6 +182,9 @@ class Model:
     nonlinear: bool = True
     element: str = "mitc"  # "mitc": MITC9 assumed strain (element/mitc.py); "full": fully integrated
     units: str = ""
+    # concrete layers: "implex" (the damage of each increment extrapolated from the last two, the
+    # implicit update committed: Oliver, Huespe & Cante 2008) or "implicit" (updated in every iteration)
+    integration: str = "implex"
     # the committed point states of the inelastic layers, per layer: [(block, state), ...] (kept
     # here by Assembler.commit for the outputs, results.evaluate_points)
     point_states: dict = field(default_factory=dict, repr=False, compare=False)

@@ -1051,7 +1051,8 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         if mf.mesh.type == "rectangle":
             _stack_boundaries_on_node_lines(m, mf)
     model = Model(m, layers, stacks, element_stack, n_thickness=mf.model.thickness_points,
-                  nonlinear=mf.model.nonlinear, units=mf.model.units, element=mf.model.element)
+                  nonlinear=mf.model.nonlinear, units=mf.model.units, element=mf.model.element,
+                  integration=mf.steps.integration)
     try:
         model.below()
     except ValueError as exc:

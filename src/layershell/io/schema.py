@@ -651,6 +651,11 @@ class Steps(Strict):
         "factorisation costs; 'auto' (default): on models whose factorisation costs at least 16 GMRES "
         "iterations (about 15 000 DOFs and up), 'always', 'never'. The answer is the same to the Newton "
         "tolerance; summary.json 'linear_solves' counts factorisations and GMRES solves")
+    integration: Literal["implex", "implicit"] = Field("implex", description=(
+        "concrete layers: 'implex' (default): each increment acts with the damage extrapolated from the last two "
+        "converged increments and commits the implicit update (Oliver, Huespe & Cante 2008; robust: no "
+        "loading/unloading switches within the Newton iterations; the error shrinks with the increment); "
+        "'implicit': damage updated in every iteration with the consistent tangent"))
     control: Literal["load", "arc_length"] = Field(
         "load", description="'load': the load factor λ is stepped (it scales forces and prescribed support "
         "displacements alike: displacement control is a [[supports]] 'fix' with 'value'); 'arc_length': λ is an "

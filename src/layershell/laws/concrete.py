@@ -28,6 +28,7 @@ shell's failure mode).
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -40,6 +41,9 @@ KAPPA_TC = 0.8  # tension-compression slope of Kupfer & Gerstle (1973), J. Eng. 
 # fib Model Code 2010 Table 5.1-8: strain at peak stress ε_c1 (‰) per characteristic strength f_ck (MPa)
 MC2010_EPS_C1 = ((12, 1.8), (16, 1.9), (20, 2.1), (25, 2.2), (30, 2.3), (35, 2.3), (40, 2.4), (45, 2.5),
                  (50, 2.6), (55, 2.6), (60, 2.7), (70, 2.7), (80, 2.8), (90, 2.8), (100, 3.0), (120, 3.0))
+#: the largest damage an IMPL-EX step acts with: a residual stiffness of 10⁻⁶ E keeps the tangent of
+#: a fully opened crack regular (the implicit state itself goes on to d = 1)
+MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
 NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
 
 
@@ -220,12 +224,18 @@ class ConcreteLaw:
         dh_dc = -h_in * c / np.where(s > 0, s, 1.0) + h_z * np.sign(c)
         return h, v, dh_dc[:, None] * spectral.eigvec_derivative_row(V, w, 2, normal)
 
-    def response(self, eps, committed: ConcreteState, h_in, h_z, normal, tangent: bool = True):
+    def response(self, eps, committed: ConcreteState, h_in, h_z, normal, tangent: bool = True,
+                 implex: ConcreteState | None = None):
         """Stress (n, 6), consistent tangent dσ/dε (n, 6, 6) or None, and the trial state.
 
         ``eps`` (n, 6) Voigt strains with engineering shears; ``h_in``, ``h_z`` (n,) element size and
         thickness-point spacing; ``normal`` (n, 3) unit shell normal. ``committed`` is not modified.
+        ``implex``: the histories extrapolated to this step (IMPL-EX, Oliver, Huespe & Cante 2008):
+        stress and tangent take the damage of its r_t, r_c (bands of ``committed``) at frozen damage;
+        the trial state is the implicit update as without it.
         """
+        if implex is not None:
+            return self._implex(eps, committed, h_in, h_z, normal, tangent, implex)
         eps = np.atleast_2d(np.asarray(eps, float))
         n = eps.shape[0]
         h_in, h_z = np.broadcast_to(np.asarray(h_in, float), (n,)), np.broadcast_to(np.asarray(h_z, float), (n,))
@@ -274,6 +284,40 @@ class ConcreteLaw:
         sp = np.einsum("nk,nka->na", wp, P)
         M -= sp[:, :, None] * g_t_row[:, None, :] + (sbar - sp)[:, :, None] * g_c_row[:, None, :]
         return sigma, M @ self.stiffness(), trial
+
+    def extrapolate(self, previous: ConcreteState, current: ConcreteState, ratio: float = 1.0) -> ConcreteState:
+        """The histories of the next increment by IMPL-EX's linear extrapolation in pseudo-time:
+        r̃ = r_n + ratio (r_n − r_(n−1)), ``ratio`` = the next increment over the last one."""
+        return dataclasses.replace(current, r_t=current.r_t + ratio * (current.r_t - previous.r_t),
+                                   r_c=current.r_c + ratio * (current.r_c - previous.r_c))
+
+    def implex_error(self, trial: ConcreteState, implex: ConcreteState) -> np.ndarray:
+        """Per point, how far the damage an IMPL-EX increment acted with is off the implicit update:
+        max(|d⁺(r_t) − d̃⁺|, |d⁻(r_c) − d̃⁻|) (d̃ from the extrapolated histories; d̃⁺ = 0 where the
+        increment started uncracked)."""
+        d_t, _, _ = self.damage_tension(trial.r_t, trial.h_t)
+        d_tx, _, _ = self.damage_tension(implex.r_t, implex.h_t)
+        d_tx = np.where(implex.h_t > 0, d_tx, 0.0)
+        d_c, _ = self.damage_compression(trial.r_c, trial.h_c)
+        d_cx, _ = self.damage_compression(implex.r_c, trial.h_c)
+        return np.maximum(np.abs(d_t - np.minimum(d_tx, 1.0)), np.abs(d_c - d_cx))
+
+    def _implex(self, eps, committed, h_in, h_z, normal, tangent, implex):
+        """The IMPL-EX response: σ = (1 − d̃⁺) σ̄⁺ + (1 − d̃⁻) σ̄⁻ with the damage of the extrapolated
+        histories (d̃⁺ = 0 where the point has not cracked at the last commit), its tangent at that
+        frozen damage, and the implicit trial state."""
+        _, _, trial = self.response(eps, committed, h_in, h_z, normal, False)
+        d_t, _, _ = self.damage_tension(implex.r_t, committed.h_t)
+        d_t = np.where(committed.h_t > 0, d_t, 0.0)
+        d_c, _ = self.damage_compression(implex.r_c, np.broadcast_to(np.asarray(h_in, float), implex.r_c.shape))
+        d_t, d_c = np.minimum(d_t, MAX_IMPLEX_DAMAGE), np.minimum(d_c, MAX_IMPLEX_DAMAGE)
+        sbar = np.atleast_2d(np.asarray(eps, float)) @ self.stiffness()
+        w, V, P = spectral.principal(sbar)
+        s = (1.0 - d_t)[:, None] * np.maximum(w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(w, 0.0)
+        sigma = np.einsum("nk,nka->na", s, P)
+        if not tangent:
+            return sigma, None, trial
+        return sigma, self._split_derivative(V, w, d_t, d_c) @ self.stiffness(), trial
 
     @staticmethod
     def _split_derivative(V, w, d_t, d_c):

@@ -41,10 +41,10 @@ import numpy as np
 
 from . import linear
 from .newton import (FRICTION_STAGNATION, MAX_REFREEZE, RELAX_AFTER_CUTS, ActiveSetLoop, ConvergenceError,
-                     NewtonSettings, StepResult, active_set_blocks, at_round_off_floor, check_stabilised_step,
-                     cohesive_hint, contact_hint, contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze,
+                     NewtonResult, NewtonSettings, StepResult, active_set_blocks, at_round_off_floor,
+                     check_stabilised_step, cohesive_hint, contact_hint, contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze,
                      friction_acts, newton, reaction_scale, record_scale, relax, resolve, stabilise, stagnates,
-                     start_inertia)
+                     implex_checked, next_increment, start_inertia)
 from .problem import Problem, commit_state
 
 
@@ -783,6 +783,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     # which no new one starts (where the last one ended without passing, see stretch_may_start)
     stretch_from, stretch_accepted, stretch_block = lam, 0, -math.inf
     end_cuts = 0  # increments cut since they passed λ_end where load control could not reach it (END_CUTS)
+    implex_last: tuple[str, float] | None = None  # (mode, size) of the last accepted increment (IMPL-EX)
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
@@ -807,16 +808,23 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             to_end = False
+            # IMPL-EX: the damage rate of the last accepted increment scaled to this one's size
+            next_increment(problem, ratio=(st.size / implex_last[1] if implex_last is not None
+                                           and implex_last[0] == st.mode and implex_last[1] > 0 else 1.0))
             e_rel = 0.0
             if st.mode == "load":
                 dlam = min(st.size, end - lam)
                 to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
                 trial = end if to_end else lam + dlam
-                u_new, res = newton(problem, u, trial, s)
+                u_new, res = implex_checked(problem, newton(problem, u, trial, s), cuts)
                 att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
             else:
                 att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
                                   max(st.lam_peak, abs(lam)), f_itf0)
+                if att.converged:
+                    _, chk = implex_checked(problem, (att.u, NewtonResult(True, att.iterations, att.residuals)), cuts)
+                    if not chk.converged:
+                        att = Attempt(False, att.u, att.lam, att.iterations, att.residuals, chk.message)
                 if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
                     u_new, res = newton(problem, u, end, s)
                     if res.converged:
@@ -1029,6 +1037,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             st.size *= 0.5
         # accepted increment
         commit_state(problem, att.u)
+        implex_last = (st.mode, abs(att.lam - lam) if st.mode == "load" else st.size)
         du = att.u - u
         dlam = att.lam - lam
         conj = conjugates(problem, att.u) if displacement_path else None  # (v, R) at the new state

@@ -47,6 +47,8 @@ class Problem:
     # the damping term of a pseudo-transient relaxation (solver/newton.py PseudoViscosity), added
     # to every residual and tangent while set; None: the static problem
     pseudo: object = field(default=None, repr=False)
+    # IMPL-EX increments accepted beyond their damage tolerance after IMPLEX_CUTS cuts: their errors
+    implex_accepted: list = field(default_factory=list, repr=False)
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
@@ -129,10 +131,10 @@ class Problem:
                 out[k] = out.get(k, 0) + v
         return out
 
-    def commit(self, u: np.ndarray) -> None:
-        """Take the material state of the inelastic layers at the converged ``u`` as committed
-        (nothing without inelastic layers)."""
-        self.assembler.commit(u)
+    def commit(self, u: np.ndarray, lam: float | None = None) -> None:  # noqa: D401
+        """Take the material state of the inelastic layers at the converged ``u`` (load factor
+        ``lam``) as committed (nothing without inelastic layers)."""
+        self.assembler.commit(u, lam)
 
     def snapshot(self) -> dict:
         """Copy of the mutable delamination state (bond flags, per-point history, friction
@@ -189,10 +191,10 @@ class Problem:
         return F if self.F_friction is None else F + self.F_friction
 
 
-def commit_state(problem, u: np.ndarray) -> None:
-    """Commit the material state of a converged ``u`` where the problem has one (stand-ins of a
-    problem in the solver's tests have none)."""
+def commit_state(problem, u: np.ndarray, lam: float | None = None) -> None:
+    """Commit the material state of a converged ``u`` at load factor ``lam`` where the problem has
+    one (stand-ins of a problem in the solver's tests have none)."""
     commit = getattr(problem, "commit", None)
     if commit is not None:
-        commit(u)
+        commit(u, lam)
 
