@@ -248,10 +248,11 @@ def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, 
 
 
 def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice,
-                       committed: LayerState):
+                       committed: LayerState, fast: bool = True):
     """Forces ``(e, m)``, tangent ``(e, m, m)`` and the trial :class:`LayerState` of the elements
     ``sl`` (a contiguous range) from their nodal vectors ``U (e, a, 3)`` and the committed state
-    of the whole block."""
+    of the whole block. ``fast``: the bulk through the compiled kernel (:mod:`.inelastic_kernel`),
+    else through the plain NumPy forms of the layer kernels (the independent check)."""
     lo, hi, _ = sl.indices(block.h_in.shape[0])
     sl = slice(lo, hi)
     trial_bulk = None
@@ -269,7 +270,12 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
             ne = E.shape[0]
             return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
 
-        f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
+        if fast:
+            from .inelastic_kernel import bulk_response
+
+            f, K = bulk_response(block.base, U, nonlinear, tangent, sl, stress)
+        else:
+            f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
         trial_bulk = out["trial"]
     trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):

@@ -1,0 +1,181 @@
+"""Compiled point loops of the inelastic layer kernel (Numba, ``cache=True``, GIL released).
+
+Imported lazily by :mod:`layershell.element.inelastic_kernel`. The material law is not evaluated
+here: these loops give the strain at the points, and from the law's stress S and tangent D there
+the internal force f = Σ Bᵀ S dV and the operands of K = Σ Bᵀ (D dV) B + the geometric term
+(``kernel.py``, ``mitc.py`` for the equations; D may be unsymmetric).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True, nogil=True)
+def full_strains(g, U, nonlinear, E):  # pragma: no cover
+    """Voigt Green-Lagrange strain (engineering shear) E (e, q, 6) of the full element at its
+    points from the basis gradients g (e, q, a, 3) and the nodal vectors U (e, a, 3)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    H = np.empty((3, 3))
+    for e in range(ne):
+        for q in range(nq):
+            for i in range(3):
+                for J in range(3):
+                    H[i, J] = 0.0
+            for a in range(na):
+                for i in range(3):
+                    u = U[e, a, i]
+                    for J in range(3):
+                        H[i, J] += u * g[e, q, a, J]
+            for V in range(6):
+                I = (0, 1, 2, 1, 0, 0)[V]
+                J = (0, 1, 2, 2, 2, 1)[V]
+                s = H[I, J] + H[J, I]
+                if nonlinear:
+                    s += H[0, I] * H[0, J] + H[1, I] * H[1, J] + H[2, I] * H[2, J]
+                E[e, q, V] = 0.5 * s if V < 3 else s
+
+
+@njit(cache=True, nogil=True)
+def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
+    """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
+    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
+    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    H = np.empty((3, 3))
+    F = np.empty((3, 3))
+    Sm = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Bv = np.empty((6, 3))
+    Dw = np.empty((6, 6))
+    for e in range(ne):
+        for a in range(na):
+            for i in range(3):
+                f[e, a, i] = 0.0
+        for q in range(nq):
+            for i in range(3):
+                for J in range(3):
+                    H[i, J] = 0.0
+            if nonlinear:
+                for a in range(na):
+                    for i in range(3):
+                        u = U[e, a, i]
+                        for J in range(3):
+                            H[i, J] += u * g[e, q, a, J]
+            for I in range(3):
+                for J in range(3):
+                    F[I, J] = (1.0 if I == J else 0.0) + H[I, J]
+            w = dV[e, q]
+            Sm[0, 0], Sm[1, 1], Sm[2, 2] = S[e, q, 0] * w, S[e, q, 1] * w, S[e, q, 2] * w
+            Sm[1, 2] = Sm[2, 1] = S[e, q, 3] * w
+            Sm[0, 2] = Sm[2, 0] = S[e, q, 4] * w
+            Sm[0, 1] = Sm[1, 0] = S[e, q, 5] * w
+            for K in range(3):
+                for i in range(3):
+                    P[K, i] = Sm[K, 0] * F[i, 0] + Sm[K, 1] * F[i, 1] + Sm[K, 2] * F[i, 2]
+            for a in range(na):
+                g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                for i in range(3):
+                    f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
+            if want_x:
+                for V in range(6):
+                    for W in range(6):
+                        Dw[V, W] = D[e, q, V, W] * w
+                for a in range(na):
+                    g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                    for i in range(3):  # B_V,(a i) = ∂E_V/∂U_ai (engineering shear)
+                        Bv[0, i] = F[i, 0] * g0
+                        Bv[1, i] = F[i, 1] * g1
+                        Bv[2, i] = F[i, 2] * g2
+                        Bv[3, i] = F[i, 1] * g2 + F[i, 2] * g1
+                        Bv[4, i] = F[i, 0] * g2 + F[i, 2] * g0
+                        Bv[5, i] = F[i, 0] * g1 + F[i, 1] * g0
+                    for V in range(6):
+                        for i in range(3):
+                            X[e, q, V, a, i] = Bv[V, i]
+                            s = 0.0
+                            for W in range(6):
+                                s += Dw[V, W] * Bv[W, i]
+                            Y[e, q, V, a, i] = s
+            if want_geo:
+                for a in range(na):
+                    g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                    for K in range(3):
+                        GS[e, a, q, K] = g0 * Sm[0, K] + g1 * Sm[1, K] + g2 * Sm[2, K]
+                        GT[e, a, q, K] = g[e, q, a, K]
+
+
+@njit(cache=True, nogil=True)
+def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
+    """Cartesian tied strain E (e, z, 9, 6) = T Ẽ at the Gauss points from the tie-space strains
+    Ek (e, z, nT): Ẽ_c(q) = Σ_t (w[c, q, t] + v[k]) E_k, k = off[c] + t (v (e, z, nT) the
+    consistency correction, zeros without it)."""
+    ne, nz = Ek.shape[0], Ek.shape[1]
+    Et = np.empty(6)
+    for e in range(ne):
+        for z in range(nz):
+            for q in range(9):
+                for c in range(6):
+                    s = 0.0
+                    for t in range(n[c]):
+                        k = off[c] + t
+                        s += (w[c, q, t] + v[e, z, k]) * Ek[e, z, k]
+                    Et[c] = s
+                for V in range(6):
+                    s = 0.0
+                    for c in range(6):
+                        s += T[e, z, q, V, c] * Et[c]
+                    E[e, z, q, V] = s
+
+
+@njit(cache=True, nogil=True)
+def mitc_tie_stress(S, D, dV, T, w, v, off, n, tangent, sig, Ch):  # pragma: no cover
+    """Tie-space stress sig (e, z, nT) = Σ_q h_qᵀ S̃_q and, with ``tangent``, the unsymmetric tied
+    stiffness Ch (e, z, nT, nT) = Σ_q h_qᵀ C̃_q h_q from the law's Cartesian S (e, z, 9, 6) and
+    D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV, h_q[c, k] = w[c, q, t] + v[k] for the ties
+    k = off[c] + t of component c."""
+    ne, nz, nT = sig.shape[0], sig.shape[1], sig.shape[2]
+    St = np.empty(6)
+    DT = np.empty((6, 6))
+    Ct = np.empty((6, 6))
+    h = np.empty((6, 9))
+    for e in range(ne):
+        for z in range(nz):
+            for k in range(nT):
+                sig[e, z, k] = 0.0
+                if tangent:
+                    for l in range(nT):
+                        Ch[e, z, k, l] = 0.0
+            for q in range(9):
+                wq = dV[e, z, q]
+                for c in range(6):
+                    s = 0.0
+                    for V in range(6):
+                        s += T[e, z, q, V, c] * S[e, z, q, V]
+                    St[c] = s * wq
+                    for t in range(n[c]):
+                        h[c, t] = w[c, q, t] + v[e, z, off[c] + t]
+                        sig[e, z, off[c] + t] += h[c, t] * St[c]
+                if not tangent:
+                    continue
+                for V in range(6):
+                    for d in range(6):
+                        s = 0.0
+                        for W in range(6):
+                            s += D[e, z, q, V, W] * T[e, z, q, W, d]
+                        DT[V, d] = s
+                for c in range(6):
+                    for d in range(6):
+                        s = 0.0
+                        for V in range(6):
+                            s += T[e, z, q, V, c] * DT[V, d]
+                        Ct[c, d] = s * wq
+                for c in range(6):
+                    for t in range(n[c]):
+                        k = off[c] + t
+                        for d in range(6):
+                            hc = h[c, t] * Ct[c, d]
+                            if hc == 0.0:
+                                continue
+                            for u in range(n[d]):
+                                Ch[e, z, k, off[d] + u] += hc * h[d, u]
