@@ -11,7 +11,7 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def full_strains(g, U, nonlinear, E):  # pragma: no cover
     """Voigt Green-Lagrange strain (engineering shear) E (e, q, 6) of the full element at its
     points from the basis gradients g (e, q, a, 3) and the nodal vectors U (e, a, 3)."""
@@ -36,7 +36,7 @@ def full_strains(g, U, nonlinear, E):  # pragma: no cover
                 E[e, q, V] = 0.5 * s if V < 3 else s
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
     """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
     internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
@@ -105,7 +105,7 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
                         GT[e, a, q, K] = g[e, q, a, K]
 
 
-@njit(cache=True, nogil=True)
+@njit(cache=True, nogil=True, fastmath=True)
 def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
     """Cartesian tied strain E (e, z, 9, 6) = T Ẽ at the Gauss points from the tie-space strains
     Ek (e, z, nT): Ẽ_c(q) = Σ_t (w[c, q, t] + v[k]) E_k, k = off[c] + t (v (e, z, nT) the
@@ -128,24 +128,32 @@ def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
                     E[e, z, q, V] = s
 
 
-@njit(cache=True, nogil=True)
-def mitc_tie_stress(S, D, dV, T, w, v, off, n, tangent, sig, Ch):  # pragma: no cover
+@njit(cache=True, nogil=True, fastmath=True)
+def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # pragma: no cover
     """Tie-space stress sig (e, z, nT) = Σ_q h_qᵀ S̃_q and, with ``tangent``, the unsymmetric tied
     stiffness Ch (e, z, nT, nT) = Σ_q h_qᵀ C̃_q h_q from the law's Cartesian S (e, z, 9, 6) and
-    D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV, h_q[c, k] = w[c, q, t] + v[k] for the ties
-    k = off[c] + t of component c."""
+    D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV. h_q = W_q + V: the tying functions W_q at Gauss
+    point q, given by their non-zeros (qn[q] entries: component qc, tie qk, value qw), and the
+    consistency correction V[c, k] = v[k] for c = comp[k] (the same at every q), so that
+    Ĉ = Σ_q W_qᵀ C̃_q W_q + Vᵀ R + L V + Vᵀ C0 V with R = Σ_q C̃_q W_q, L = Σ_q W_qᵀ C̃_q, C0 = Σ_q C̃_q."""
     ne, nz, nT = sig.shape[0], sig.shape[1], sig.shape[2]
     St = np.empty(6)
+    S0 = np.empty(6)
     DT = np.empty((6, 6))
     Ct = np.empty((6, 6))
-    h = np.empty((6, 9))
+    C0 = np.empty((6, 6))
+    R = np.empty((6, nT))
+    L = np.empty((nT, 6))
     for e in range(ne):
         for z in range(nz):
             for k in range(nT):
                 sig[e, z, k] = 0.0
-                if tangent:
-                    for l in range(nT):
-                        Ch[e, z, k, l] = 0.0
+            S0[:] = 0.0
+            if tangent:
+                Ch[e, z] = 0.0
+                C0[:] = 0.0
+                R[:] = 0.0
+                L[:] = 0.0
             for q in range(9):
                 wq = dV[e, z, q]
                 for c in range(6):
@@ -153,9 +161,9 @@ def mitc_tie_stress(S, D, dV, T, w, v, off, n, tangent, sig, Ch):  # pragma: no 
                     for V in range(6):
                         s += T[e, z, q, V, c] * S[e, z, q, V]
                     St[c] = s * wq
-                    for t in range(n[c]):
-                        h[c, t] = w[c, q, t] + v[e, z, off[c] + t]
-                        sig[e, z, off[c] + t] += h[c, t] * St[c]
+                    S0[c] += St[c]
+                for j in range(qn[q]):
+                    sig[e, z, qk[q, j]] += qw[q, j] * St[qc[q, j]]
                 if not tangent:
                     continue
                 for V in range(6):
@@ -170,12 +178,26 @@ def mitc_tie_stress(S, D, dV, T, w, v, off, n, tangent, sig, Ch):  # pragma: no 
                         for V in range(6):
                             s += T[e, z, q, V, c] * DT[V, d]
                         Ct[c, d] = s * wq
-                for c in range(6):
-                    for t in range(n[c]):
-                        k = off[c] + t
-                        for d in range(6):
-                            hc = h[c, t] * Ct[c, d]
-                            if hc == 0.0:
-                                continue
-                            for u in range(n[d]):
-                                Ch[e, z, k, off[d] + u] += hc * h[d, u]
+                        C0[c, d] += Ct[c, d]
+                for j1 in range(qn[q]):
+                    k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
+                    for j2 in range(qn[q]):
+                        Ch[e, z, k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
+                    for d in range(6):
+                        L[k, d] += w1 * Ct[c, d]
+                        R[d, k] += Ct[d, c] * w1
+            anyv = False
+            for k in range(nT):
+                if v[e, z, k] != 0.0:
+                    anyv = True
+            if not anyv:
+                continue
+            for k in range(nT):
+                sig[e, z, k] += v[e, z, k] * S0[comp[k]]
+            if not tangent:
+                continue
+            for k in range(nT):
+                vk, ck = v[e, z, k], comp[k]
+                for l in range(nT):
+                    vl, cl = v[e, z, l], comp[l]
+                    Ch[e, z, k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl

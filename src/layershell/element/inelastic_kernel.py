@@ -19,7 +19,6 @@ last step.
 """
 from __future__ import annotations
 
-from contextlib import nullcontext
 
 import numpy as np
 
@@ -108,6 +107,28 @@ def _mitc_args(block, lo: int, hi: int):
             tie.ndir, tie.gn, tie.gk, tie.gJ)
 
 
+def _tying_nonzeros(tie):
+    """The non-zeros of the tying functions at each Gauss point q: their number (9,), component,
+    tie-space index and value (9, n) each (padded), and the component of each tie (nT,). The
+    tying points of E_11, E_22, E_23, E_13 lie on Gauss lines, so 13 of the 37 ties reach a point."""
+    key = id(tie)
+    if key in _NONZEROS and _NONZEROS[key][0] is tie:
+        return _NONZEROS[key][1]
+    nz = [[(c, int(tie.off[c] + t), float(tie.w[c, q, t])) for c in range(6) for t in range(int(tie.n[c]))
+           if tie.w[c, q, t] != 0.0] for q in range(9)]
+    width = max(len(r) for r in nz)
+    qn = np.array([len(r) for r in nz], np.int64)
+    qc, qk, qw = np.zeros((9, width), np.int64), np.zeros((9, width), np.int64), np.zeros((9, width))
+    for q, r in enumerate(nz):
+        for j, (c, k, w) in enumerate(r):
+            qc[q, j], qk[q, j], qw[q, j] = c, k, w
+    _NONZEROS[key] = (tie, (qn, qc, qk, qw, tie.component()))
+    return _NONZEROS[key][1]
+
+
+_NONZEROS: dict = {}  # id(tying) -> (tying, its non-zeros); the tyings are cached (mitc.tying)
+
+
 def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
     from . import _jit, _jit_inelastic as jit
 
@@ -133,6 +154,7 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
     K = np.empty((e, m, m)) if tangent else None
     geo = tangent and nonlinear
     ncol = nz * int(tie.ndir.sum())
+    nzw = _tying_nonzeros(tie)
 
     def work(r0: int, r1: int) -> None:
         for s in range(r0, r1, _SUB):
@@ -140,8 +162,7 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
             nb = t - s
             sig = np.empty((nb, nz, nT))
             Ch = np.empty((nb, nz, nT, nT)) if tangent else _NONE4
-            jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], tie.w, v[s:t], tie.off, tie.n,
-                                tangent, sig, Ch)
+            jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], *nzw, v[s:t], tangent, sig, Ch)
             B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
             GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))
             GT = np.empty_like(GS)
