@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+_VMAP = np.array([[0, 5, 4], [5, 1, 3], [4, 3, 2]], dtype=np.int64)  # Voigt index of (J, K)
+
 
 @njit(cache=True, nogil=True, fastmath=True)
 def full_strains(g, U, nonlinear, E):  # pragma: no cover
@@ -40,14 +42,16 @@ def full_strains(g, U, nonlinear, E):  # pragma: no cover
 def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
     """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
     internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
-    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3)."""
+    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3).
+    As in ``_jit.point_terms``: B_W,(a i) = Σ_K g_aK Φ_WKi with Φ_WKi = Σ_J F_iJ [Voigt(J, K) = W]
+    and (D dV B)_W,(a i) = Σ_K g_aK Ψ_WKi with Ψ_WKi = Σ_J F_iJ (D dV)_W,Voigt(J, K)."""
     ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
     H = np.empty((3, 3))
     F = np.empty((3, 3))
     Sm = np.empty((3, 3))
     P = np.empty((3, 3))
-    Bv = np.empty((6, 3))
-    Dw = np.empty((6, 6))
+    Phi = np.empty((6, 3, 3))
+    Psi = np.empty((6, 3, 3))
     for e in range(ne):
         for a in range(na):
             for i in range(3):
@@ -78,25 +82,23 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
                 for i in range(3):
                     f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
             if want_x:
-                for V in range(6):
-                    for W in range(6):
-                        Dw[V, W] = D[e, q, V, W] * w
-                for a in range(na):
-                    g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
-                    for i in range(3):  # B_V,(a i) = ∂E_V/∂U_ai (engineering shear)
-                        Bv[0, i] = F[i, 0] * g0
-                        Bv[1, i] = F[i, 1] * g1
-                        Bv[2, i] = F[i, 2] * g2
-                        Bv[3, i] = F[i, 1] * g2 + F[i, 2] * g1
-                        Bv[4, i] = F[i, 0] * g2 + F[i, 2] * g0
-                        Bv[5, i] = F[i, 0] * g1 + F[i, 1] * g0
-                    for V in range(6):
+                for W in range(6):
+                    for K in range(3):
                         for i in range(3):
-                            X[e, q, V, a, i] = Bv[V, i]
+                            Phi[W, K, i] = 0.0
                             s = 0.0
-                            for W in range(6):
-                                s += Dw[V, W] * Bv[W, i]
-                            Y[e, q, V, a, i] = s
+                            for J in range(3):
+                                V = _VMAP[J, K]
+                                s += F[i, J] * D[e, q, W, V]
+                                if V == W:
+                                    Phi[W, K, i] += F[i, J]
+                            Psi[W, K, i] = s * w
+                for W in range(6):
+                    for a in range(na):
+                        g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                        for i in range(3):
+                            X[e, q, W, a, i] = g0 * Phi[W, 0, i] + g1 * Phi[W, 1, i] + g2 * Phi[W, 2, i]
+                            Y[e, q, W, a, i] = g0 * Psi[W, 0, i] + g1 * Psi[W, 1, i] + g2 * Psi[W, 2, i]
             if want_geo:
                 for a in range(na):
                     g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
