@@ -137,7 +137,9 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
     D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV. h_q = W_q + V: the tying functions W_q at Gauss
     point q, given by their non-zeros (qn[q] entries: component qc, tie qk, value qw), and the
     consistency correction V[c, k] = v[k] for c = comp[k] (the same at every q), so that
-    Ĉ = Σ_q W_qᵀ C̃_q W_q + Vᵀ R + L V + Vᵀ C0 V with R = Σ_q C̃_q W_q, L = Σ_q W_qᵀ C̃_q, C0 = Σ_q C̃_q."""
+    Ĉ = Ĉ₀ + Vᵀ R + L V + Vᵀ C0 V with Ĉ₀ = Σ_q W_qᵀ C̃_q W_q, R = Σ_q C̃_q W_q = Uᵀ Ĉ₀,
+    L = Σ_q W_qᵀ C̃_q = Ĉ₀ U and C0 = Σ_q C̃_q = Uᵀ Ĉ₀ U (U the component indicator: the tying
+    functions of a component sum to 1 at every point)."""
     ne, nz, nT = sig.shape[0], sig.shape[1], sig.shape[2]
     St = np.empty(6)
     S0 = np.empty(6)
@@ -146,60 +148,73 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
     C0 = np.empty((6, 6))
     R = np.empty((6, nT))
     L = np.empty((nT, 6))
+    Cl = np.empty((nT, nT))
+    sl = np.empty(nT)
     for e in range(ne):
         for z in range(nz):
-            for k in range(nT):
-                sig[e, z, k] = 0.0
+            sl[:] = 0.0
             S0[:] = 0.0
             if tangent:
-                Ch[e, z] = 0.0
+                Cl[:] = 0.0
                 C0[:] = 0.0
                 R[:] = 0.0
                 L[:] = 0.0
             for q in range(9):
                 wq = dV[e, z, q]
+                Tq = T[e, z, q]
+                Sq = S[e, z, q]
                 for c in range(6):
                     s = 0.0
                     for V in range(6):
-                        s += T[e, z, q, V, c] * S[e, z, q, V]
+                        s += Tq[V, c] * Sq[V]
                     St[c] = s * wq
-                    S0[c] += St[c]
                 for j in range(qn[q]):
-                    sig[e, z, qk[q, j]] += qw[q, j] * St[qc[q, j]]
+                    sl[qk[q, j]] += qw[q, j] * St[qc[q, j]]
                 if not tangent:
                     continue
+                Dq = D[e, z, q]
                 for V in range(6):
                     for d in range(6):
                         s = 0.0
                         for W in range(6):
-                            s += D[e, z, q, V, W] * T[e, z, q, W, d]
-                        DT[V, d] = s
+                            s += Dq[V, W] * Tq[W, d]
+                        DT[V, d] = s * wq
                 for c in range(6):
                     for d in range(6):
                         s = 0.0
                         for V in range(6):
-                            s += T[e, z, q, V, c] * DT[V, d]
-                        Ct[c, d] = s * wq
-                        C0[c, d] += Ct[c, d]
+                            s += Tq[V, c] * DT[V, d]
+                        Ct[c, d] = s
                 for j1 in range(qn[q]):
                     k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
                     for j2 in range(qn[q]):
-                        Ch[e, z, k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
-                    for d in range(6):
-                        L[k, d] += w1 * Ct[c, d]
-                        R[d, k] += Ct[d, c] * w1
+                        Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
             anyv = False
             for k in range(nT):
                 if v[e, z, k] != 0.0:
                     anyv = True
-            if not anyv:
-                continue
+            if anyv:  # the sums over the ties of a component: W_q reproduces constants
+                for k in range(nT):
+                    S0[comp[k]] += sl[k]
+                for k in range(nT):
+                    sl[k] += v[e, z, k] * S0[comp[k]]
             for k in range(nT):
-                sig[e, z, k] += v[e, z, k] * S0[comp[k]]
+                sig[e, z, k] = sl[k]
             if not tangent:
                 continue
+            if anyv:  # R = Uᵀ Ĉ₀, L = Ĉ₀ U, C0 = Uᵀ Ĉ₀ U (U the component indicator)
+                for k in range(nT):
+                    ck = comp[k]
+                    for l in range(nT):
+                        x = Cl[k, l]
+                        R[ck, l] += x
+                        L[k, comp[l]] += x
+                        C0[ck, comp[l]] += x
+                for k in range(nT):
+                    vk, ck = v[e, z, k], comp[k]
+                    for l in range(nT):
+                        vl, cl = v[e, z, l], comp[l]
+                        Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
             for k in range(nT):
-                vk, ck = v[e, z, k], comp[k]
                 for l in range(nT):
-                    vl, cl = v[e, z, l], comp[l]
-                    Ch[e, z, k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
+                    Ch[e, z, k, l] = Cl[k, l]
