@@ -327,10 +327,10 @@ def test_batch_equals_points_one_by_one():
 
 # -- the spectral split's compiled eigen-decomposition --------------------------------------------
 def test_compiled_eigh_against_lapack_with_repeated_and_scaled_eigenvalues():
-    """laws/_eigh3.eigh (Jacobi) against numpy.linalg.eigh (LAPACK): eigenvalues, A = V diag(w) Vᵀ,
+    """laws/_spectral_jit.eigh (Jacobi) against numpy.linalg.eigh (LAPACK): eigenvalues, A = V diag(w) Vᵀ,
     orthonormal V, and the projections v_k ⊗ v_k where the eigenvalue is simple (a repeated one has
     any basis of its eigenspace; there the sum of its projections is compared)."""
-    from layershell.laws._eigh3 import eigh
+    from layershell.laws._spectral_jit import eigh
 
     rng = np.random.default_rng(7)
     R = np.linalg.qr(rng.standard_normal((3, 3)))[0]
