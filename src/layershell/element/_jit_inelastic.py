@@ -153,12 +153,8 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
     for e in range(ne):
         for z in range(nz):
             sl[:] = 0.0
-            S0[:] = 0.0
             if tangent:
                 Cl[:] = 0.0
-                C0[:] = 0.0
-                R[:] = 0.0
-                L[:] = 0.0
             for q in range(9):
                 wq = dV[e, z, q]
                 Tq = T[e, z, q]
@@ -189,32 +185,46 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
                     k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
                     for j2 in range(qn[q]):
                         Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
-            anyv = False
-            for k in range(nT):
-                if v[e, z, k] != 0.0:
-                    anyv = True
-            if anyv:  # the sums over the ties of a component: W_q reproduces constants
-                for k in range(nT):
-                    S0[comp[k]] += sl[k]
-                for k in range(nT):
-                    sl[k] += v[e, z, k] * S0[comp[k]]
+            _correct(v[e, z], comp, tangent, sl, Cl, S0, R, L, C0)
             for k in range(nT):
                 sig[e, z, k] = sl[k]
             if not tangent:
                 continue
-            if anyv:  # R = Uᵀ Ĉ₀, L = Ĉ₀ U, C0 = Uᵀ Ĉ₀ U (U the component indicator)
-                for k in range(nT):
-                    ck = comp[k]
-                    for l in range(nT):
-                        x = Cl[k, l]
-                        R[ck, l] += x
-                        L[k, comp[l]] += x
-                        C0[ck, comp[l]] += x
-                for k in range(nT):
-                    vk, ck = v[e, z, k], comp[k]
-                    for l in range(nT):
-                        vl, cl = v[e, z, l], comp[l]
-                        Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
             for k in range(nT):
                 for l in range(nT):
                     Ch[e, z, k, l] = Cl[k, l]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
+    """Add the consistency correction ``v (nT,)`` of one level to its tie stresses ``sl`` and, with
+    ``tangent``, to its tied stiffness ``Cl`` (:func:`mitc_tie_stress`); nothing where v = 0."""
+    nT = sl.shape[0]
+    anyv = False
+    for k in range(nT):
+        if v[k] != 0.0:
+            anyv = True
+    if not anyv:
+        return
+    S0[:] = 0.0
+    for k in range(nT):  # the sums over the ties of a component: W_q reproduces constants
+        S0[comp[k]] += sl[k]
+    for k in range(nT):
+        sl[k] += v[k] * S0[comp[k]]
+    if not tangent:
+        return
+    R[:] = 0.0
+    L[:] = 0.0
+    C0[:] = 0.0
+    for k in range(nT):  # R = Uᵀ Ĉ₀, L = Ĉ₀ U, C0 = Uᵀ Ĉ₀ U (U the component indicator)
+        ck = comp[k]
+        for l in range(nT):
+            x = Cl[k, l]
+            R[ck, l] += x
+            L[k, comp[l]] += x
+            C0[ck, comp[l]] += x
+    for k in range(nT):
+        vk, ck = v[k], comp[k]
+        for l in range(nT):
+            vl, cl = v[l], comp[l]
+            Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
