@@ -1,10 +1,12 @@
 """Inelastic layers: the stress and tangent of a material law at every integration point of a
 layer, and reinforcement sheets (rebar, textile) inside a layer without extra DOFs.
 
-Bulk. The layer kernels' plain forms (:func:`.kernel.layer_response_reference`,
-:func:`.mitc.mitc_response_reference`) with the PK2 stress S and the tangent D = dS/dE of the law at
-the Green-Lagrange strain of each point (MITC9: the tied strain mapped to Cartesian axes) in
-place of S = C E: f = Σ Bᵀ S dV, K = Σ Bᵀ D B dV + the geometric term of S. The law sees the
+Bulk. The layer kernels with the PK2 stress S and the tangent D = dS/dE of the law at the
+Green-Lagrange strain of each point (MITC9: the tied strain mapped to Cartesian axes) in place of
+S = C E: f = Σ Bᵀ S dV, K = Σ Bᵀ D B dV + the geometric term of S; compiled
+(:mod:`.inelastic_kernel`, the law evaluated vectorised over the element range in between), or
+through the kernels' plain NumPy forms (:func:`.kernel.layer_response_reference`,
+:func:`.mitc.mitc_response_reference`; ``fast=False``, the independent check). The law sees the
 shell normal and two lengths per point for its crack band: the element's in-plane size
 h_in = √(element area) and the thickness-point spacing h_z = H / (points through the layer).
 
