@@ -20,6 +20,7 @@ alike; the load average is printed. Threads: ``LAYERSHELL_THREADS`` as for the k
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import time
 
@@ -28,6 +29,7 @@ import numpy as np
 from layershell.element.inelastic import initial_state, inelastic_block, inelastic_response, put_trial
 from layershell.element.kernel import kernel_threads, layer_response
 from layershell.laws import ConcreteLaw
+from layershell.material import Orthotropic
 from layershell.mesh import rectangle
 
 SIZE = 100.0  # element size, mm
@@ -89,14 +91,11 @@ def case(X, d: int, element: str, nz: int, law, chunk: int, repeat: int, referen
 
 
 def _slice_state(state, p):
-    import dataclasses
-
     return dataclasses.replace(state, **{f.name: getattr(state, f.name)[p] for f in dataclasses.fields(state)})
 
 
 def _mat(law):
-    from layershell.material import Orthotropic
-
+    """The law's undamaged elasticity (the elastic layer compared against, and the block's stand-in)."""
     return Orthotropic.isotropic(law.E, law.nu)
 
 
