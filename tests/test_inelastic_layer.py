@@ -188,3 +188,18 @@ def test_sheet_adds_its_axial_stiffness():
     df = (f1 - f0).reshape(9, 2, 3)[right, :, 0]
     assert df[:, 0].sum() == pytest.approx(Es * As * eps * 1.0, rel=1e-10)  # the force on director 0
     assert df[:, 1].sum() == pytest.approx(Es * As * eps * 0.05, rel=1e-10)  # its moment Θ_L N on director 1
+
+
+@pytest.mark.parametrize("element", ["full", "mitc"])
+def test_compiled_kernel_splits_elements_over_threads(element, monkeypatch):
+    """Elements over 3 threads (40 elements: 3 ranges of sub-blocks) give the one-thread result."""
+    X, Hb, H = _geometry(40, seed=6)
+    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 4e6, 3e5), (), 3, element)
+    U = 0.01 * np.random.default_rng(7).standard_normal((40, 18, 3))
+    out = {}
+    for n in ("1", "3"):
+        monkeypatch.setenv("LAYERSHELL_THREADS", n)
+        out[n] = inelastic_response(blk, U, True, True, slice(None), initial_state(blk))
+    assert np.array_equal(out["1"][0], out["3"][0]) and np.array_equal(out["1"][1], out["3"][1])
+    K0 = inelastic_response(blk, U, True, True, slice(None), initial_state(blk), fast=False)[1]
+    assert np.abs(out["3"][1] - K0).max() < 1e-12 * np.abs(K0).max()

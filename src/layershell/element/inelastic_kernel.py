@@ -19,15 +19,16 @@ last step.
 """
 from __future__ import annotations
 
+from contextlib import nullcontext
 
 import numpy as np
 
 from ..threads import blas_single_thread
 from .kernel import LayerBlock, _pool, kernel_threads
 
-_SUB = 8  # elements per sub-block: the rows B and (D dV) B of 8 elements (≤ 1.2 MB at d = 2, 6 points) stay in cache
+_SUB = 8  # elements per sub-block, as the elastic kernels (16 measured no faster): rows made and multiplied at once
 V_ROUNDOFF = 1e-13  # |v| of the tie correction below this is round-off (v = 0 on flat straight-edged elements)
-_NONE3 = np.empty((0, 0, 0))
+_NONE3 = np.empty((0, 0, 0))  # the compiled loops' array arguments that a call does not use
 _NONE4 = np.empty((0, 0, 0, 0))
 _NONE5 = np.empty((0, 0, 0, 0, 0))
 
@@ -47,10 +48,11 @@ def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slic
     return _mitc(block, U, nonlinear, tangent, lo, hi, stress)
 
 
-def _threads(n_el: int, work) -> None:
-    """``work(lo, hi)`` over element ranges, split over the kernel threads (BLAS single-threaded)."""
+def _threads(n_el: int, work, tangent: bool) -> None:
+    """``work(lo, hi)`` over element ranges, split over the kernel threads (BLAS single-threaded
+    for the tangent's products, as :func:`.kernel.layer_response`)."""
     n_threads = min(kernel_threads(), max(1, n_el // _SUB))
-    with blas_single_thread():
+    with blas_single_thread() if tangent else nullcontext():
         if n_threads == 1:
             work(0, n_el)
             return
@@ -98,7 +100,7 @@ def _full(block: LayerBlock, U, nonlinear: bool, tangent: bool, lo: int, hi: int
                 Kg = np.matmul(GS.reshape(nb, a, 3 * q), GT.reshape(nb, a, 3 * q).transpose(0, 2, 1))
                 _jit.add_geometric(K[s:t], Kg)
 
-    _threads(e, work)
+    _threads(e, work, tangent)
     return f.reshape(e, m), K
 
 
@@ -179,5 +181,5 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
             if geo:
                 _jit.add_geometric(K[s:t], np.matmul(GS.transpose(0, 2, 1), GT))
 
-    _threads(e, work)
+    _threads(e, work, tangent)
     return f, K
