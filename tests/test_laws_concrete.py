@@ -356,3 +356,27 @@ def test_compiled_eigh_against_lapack_with_repeated_and_scaled_eigenvalues():
     gap = gap > 1e-6 * scale[:, None]
     assert np.abs(outer - outer0)[gap].max() < 1e-8
     assert gap.sum() > 1000 and (~gap).sum() > 10  # both cases present
+
+
+def test_compiled_isotropic_derivative_against_its_basis_form():
+    """spectral.isotropic_derivative (compiled) against Bᵀ diag(a, θ) B W built from NumPy dyads,
+    and against finite differences of F(A) = Σ s(w_k) P_k for s(w) = w³ (θ = (s_i - s_j)/(w_i - w_j))."""
+    from layershell.laws import spectral
+
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((50, 6))
+    w, V, _ = spectral.principal(A)
+    a, theta = 3 * w ** 2, np.stack([(w[:, i] ** 3 - w[:, j] ** 3) / (w[:, i] - w[:, j]) for i, j in spectral.PAIRS], 1)
+    D = spectral.isotropic_derivative(V, a, theta)
+    B = np.stack([spectral.dyad(V[:, :, k], V[:, :, k]) for k in range(3)]
+                 + [np.sqrt(2.0) * spectral.dyad(V[:, :, i], V[:, :, j]) for i, j in spectral.PAIRS], axis=1)
+    ref = np.matmul(np.swapaxes(B, 1, 2) * np.concatenate([a, theta], 1)[:, None, :], B * spectral.WEIGHT)
+    assert np.abs(D - ref).max() < 1e-13 * np.abs(ref).max()
+
+    def F(x):
+        ww, _, P = spectral.principal(x)
+        return np.einsum("nk,nka->na", ww ** 3, P)
+
+    h = 1e-6
+    fd = np.stack([(F(A + h * np.eye(6)[c]) - F(A - h * np.eye(6)[c])) / (2 * h) for c in range(6)], -1)
+    assert np.abs(D - fd).max() < 1e-6 * np.abs(D).max()  # dF = D dA for stress-like Voigt dA
