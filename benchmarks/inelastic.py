@@ -8,6 +8,7 @@ chunks of ``--chunk`` as the assembly calls it, for d = 1, 2, the MITC9 and the 
 element and 3 and 6 thickness points. The displacements are random with strains around cracking
 and crushing, from a committed state with some damage (the state of 0.7 times them). Columns:
 
+* ``cracked``: the share of the points with a crack in the committed state;
 * ``elastic s``: :func:`layershell.element.kernel.layer_response` of the layer's elastic block;
 * ``inelastic s``: :func:`layershell.element.inelastic.inelastic_response` (compiled point work);
 * ``plain s``: the same through the kernels' plain NumPy forms (``fast=False``, the check);
