@@ -21,10 +21,12 @@ class _Hist:
 
 
 class _CubicBulk:
-    """S = C E + β (E·E) E with an irreversible history max |E| (a nonlinear law with a state)."""
+    """S = C E + β (E·E) E + γ (a·E) E with an irreversible history max |E| (a nonlinear law with a
+    state; γ ≠ 0: an unsymmetric tangent)."""
 
-    def __init__(self, mat: Orthotropic, beta: float):
-        self.C, self.beta = mat.stiffness(), beta
+    def __init__(self, mat: Orthotropic, beta: float, gamma: float = 0.0):
+        self.C, self.beta, self.gamma = mat.stiffness(), beta, gamma
+        self.a = np.array([1.0, -0.5, 0.3, 0.7, -0.2, 0.4])
 
     def state(self, n):
         return _Hist(np.zeros(n))
@@ -32,10 +34,12 @@ class _CubicBulk:
     def response(self, eps, committed, h_in, h_z, normal, tangent=True):
         assert eps.shape[0] == h_in.shape[0] == h_z.shape[0] == normal.shape[0]
         e2 = np.einsum("pv,pv->p", eps, eps)
-        S = eps @ self.C.T + self.beta * e2[:, None] * eps
+        ae = eps @ self.a
+        S = eps @ self.C.T + (self.beta * e2 + self.gamma * ae)[:, None] * eps
         D = None
         if tangent:
-            D = (self.C[None] + self.beta * (e2[:, None, None] * np.eye(6) + 2 * eps[:, :, None] * eps[:, None, :]))
+            D = (self.C[None] + self.beta * (e2[:, None, None] * np.eye(6) + 2 * eps[:, :, None] * eps[:, None, :])
+                 + self.gamma * (ae[:, None, None] * np.eye(6) + eps[:, :, None] * self.a[None, None, :]))
         return S, D, _Hist(np.maximum(committed.emax, np.sqrt(e2)))
 
 
@@ -101,9 +105,52 @@ def test_tangent_of_a_nonlinear_law_with_sheets_equals_finite_differences(elemen
     X, Hb, H = _geometry(2)
     sheets = (("bars x", _CubicSheet(200000.0, 5e7), 0.04, 0.003, 0.0, (1.0, 0.0, 0.0)),
               ("bars 30", _CubicSheet(200000.0, -3e7), 0.15, 0.002, 30.0, None))
-    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 4e6), sheets, 3, element)
+    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 4e6, 3e5), sheets, 3, element)
     U = 0.01 * np.random.default_rng(2).standard_normal((2, 18, 3))
+    K = inelastic_response(blk, U, True, True, slice(None), initial_state(blk))[1]
+    assert np.abs(K - K.transpose(0, 2, 1)).max() > 1e-3 * np.abs(K).max()  # the unsymmetric tangent is kept
     assert _fd_check(blk, U, initial_state(blk)) < 1e-6
+
+
+def _flat(n_el=3):
+    """Flat rectangular elements with straight edges (the MITC9 tie correction is round-off)."""
+    xi, eta = NODE_XI.T
+    X = np.stack([np.stack([1.5 * e + 0.75 * (1 + xi), 0.5 * (1 + eta), 0 * xi], -1) for e in range(n_el)])
+    return X, np.full((n_el, 9), 0.05), np.full((n_el, 9), 0.2)
+
+
+@pytest.mark.parametrize("mesh", ["distorted", "flat"])
+@pytest.mark.parametrize("nonlinear", [True, False])
+@pytest.mark.parametrize("d", [1, 2])
+@pytest.mark.parametrize("element", ["full", "mitc"])
+def test_compiled_kernel_equals_the_plain_forms(element, d, nonlinear, mesh):
+    """The compiled bulk kernel (element/inelastic_kernel.py) against the layer kernels' plain
+    NumPy forms with the same law: forces, the unsymmetric tangent, the trial state and strains of
+    an element range, with sheets, from a committed state with history."""
+    n_el = 11
+    X, Hb, H = _geometry(n_el, seed=4) if mesh == "distorted" else _flat(n_el)
+    sheets = (("bars x", _CubicSheet(200000.0, 5e7), 0.04, 0.003, 0.0, (1.0, 0.0, 0.0)),
+              ("bars 30", _CubicSheet(200000.0, -3e7), 0.15, 0.002, 30.0, None))
+    blk = inelastic_block(X, Hb, H, d, MAT, _CubicBulk(MAT, 4e6, 3e5), sheets, 3, element)
+    if element == "mitc":  # the tie correction: exercised on the distorted mesh, round-off on the flat one
+        v = np.abs(blk.base.v).max()
+        assert (v > 1e-3) if mesh == "distorted" else (v < 1e-12)
+    rng = np.random.default_rng(5)
+    U = 0.01 * rng.standard_normal((n_el, 9 * (d + 1), 3))
+    c = initial_state(blk)
+    put_trial(c, blk, slice(None), inelastic_response(blk, 0.7 * U, nonlinear, False, slice(None), c)[2])
+    sl = slice(2, 11)
+    for tangent in (True, False):
+        f0, K0, t0 = inelastic_response(blk, U[sl], nonlinear, tangent, sl, c, fast=False)
+        f1, K1, t1 = inelastic_response(blk, U[sl], nonlinear, tangent, sl, c, fast=True)
+        assert np.abs(f1 - f0).max() < 1e-12 * np.abs(f0).max()
+        assert np.abs(t1.strain - t0.strain).max() < 1e-12 * np.abs(t0.strain).max()
+        assert np.abs(t1.bulk.emax - t0.bulk.emax).max() < 1e-12 * t0.bulk.emax.max()
+        assert np.any(t0.bulk.emax > c.bulk.emax[2 * blk.n_points:])  # some points load beyond their history
+        if tangent:
+            assert np.abs(K1 - K0).max() < 1e-12 * np.abs(K0).max()
+        else:
+            assert K1 is None and K0 is None
 
 
 def test_trial_state_is_written_per_element_range_and_committed_state_untouched():
@@ -141,3 +188,18 @@ def test_sheet_adds_its_axial_stiffness():
     df = (f1 - f0).reshape(9, 2, 3)[right, :, 0]
     assert df[:, 0].sum() == pytest.approx(Es * As * eps * 1.0, rel=1e-10)  # the force on director 0
     assert df[:, 1].sum() == pytest.approx(Es * As * eps * 0.05, rel=1e-10)  # its moment Θ_L N on director 1
+
+
+@pytest.mark.parametrize("element", ["full", "mitc"])
+def test_compiled_kernel_splits_elements_over_threads(element, monkeypatch):
+    """Elements over 3 threads (40 elements: 3 ranges of sub-blocks) give the one-thread result."""
+    X, Hb, H = _geometry(40, seed=6)
+    blk = inelastic_block(X, Hb, H, 1, MAT, _CubicBulk(MAT, 4e6, 3e5), (), 3, element)
+    U = 0.01 * np.random.default_rng(7).standard_normal((40, 18, 3))
+    out = {}
+    for n in ("1", "3"):
+        monkeypatch.setenv("LAYERSHELL_THREADS", n)
+        out[n] = inelastic_response(blk, U, True, True, slice(None), initial_state(blk))
+    assert np.array_equal(out["1"][0], out["3"][0]) and np.array_equal(out["1"][1], out["3"][1])
+    K0 = inelastic_response(blk, U, True, True, slice(None), initial_state(blk), fast=False)[1]
+    assert np.abs(out["3"][1] - K0).max() < 1e-12 * np.abs(K0).max()

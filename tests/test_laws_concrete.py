@@ -323,3 +323,60 @@ def test_batch_equals_points_one_by_one():
         assert t1.r_t[0] == tr.r_t[i] and t1.h_t[0] == tr.h_t[i]
     with pytest.raises(ValueError, match="h_in and h_z"):
         law.response(eps, committed, 0.0, 15.0, NZ)
+
+
+# -- the spectral split's compiled eigen-decomposition --------------------------------------------
+def test_compiled_eigh_against_lapack_with_repeated_and_scaled_eigenvalues():
+    """laws/_spectral_jit.eigh (Jacobi) against numpy.linalg.eigh (LAPACK): eigenvalues, A = V diag(w) Vᵀ,
+    orthonormal V, and the projections v_k ⊗ v_k where the eigenvalue is simple (a repeated one has
+    any basis of its eigenspace; there the sum of its projections is compared)."""
+    from layershell.laws._spectral_jit import eigh
+
+    rng = np.random.default_rng(7)
+    R = np.linalg.qr(rng.standard_normal((3, 3)))[0]
+    spectra = [rng.standard_normal(3) for _ in range(200)] + [
+        np.array(x, float) for x in ([1, 1, 2], [-3, 5, 5], [2, 2, 2], [0, 0, 0], [1, 1 + 1e-12, -3],
+                                     [1e-300, 2e-300, -1e-300], [1e8, 1, -1e-8])]
+    A = np.stack([R @ np.diag(w) @ R.T if k % 2 else np.diag(w) for k, w in enumerate(spectra)])
+    A = np.concatenate([A, rng.standard_normal((200, 3, 3))])
+    A = 0.5 * (A + A.transpose(0, 2, 1))
+    w, V, P = eigh(A, projections=True)
+    w0, V0 = np.linalg.eigh(A)
+    scale = np.abs(A).max(axis=(1, 2)) + 1e-300
+    assert np.all(np.abs(w - w0).max(axis=1) <= 1e-14 * scale)
+    assert np.all(np.diff(w, axis=1) >= 0)
+    assert np.abs(np.einsum("nki,nkj->nij", V, V) - np.eye(3)).max() < 1e-14
+    assert np.all(np.abs(np.einsum("nik,nk,njk->nij", V, w, V) - A).max(axis=(1, 2)) <= 1e-14 * scale)
+    outer = np.einsum("nik,njk->nkij", V, V)
+    Pv = np.stack([outer[..., 0, 0], outer[..., 1, 1], outer[..., 2, 2], outer[..., 1, 2], outer[..., 0, 2],
+                   outer[..., 0, 1]], -1)
+    assert np.abs(P - Pv).max() < 1e-15
+    outer0 = np.einsum("nik,njk->nkij", V0, V0)
+    gap = np.min(np.where(np.eye(3, dtype=bool), np.inf, np.abs(w0[:, :, None] - w0[:, None, :])), axis=2)
+    gap = gap > 1e-6 * scale[:, None]
+    assert np.abs(outer - outer0)[gap].max() < 1e-8
+    assert gap.sum() > 1000 and (~gap).sum() > 10  # both cases present
+
+
+def test_compiled_isotropic_derivative_against_its_basis_form():
+    """spectral.isotropic_derivative (compiled) against Bᵀ diag(a, θ) B W built from NumPy dyads,
+    and against finite differences of F(A) = Σ s(w_k) P_k for s(w) = w³ (θ = (s_i - s_j)/(w_i - w_j))."""
+    from layershell.laws import spectral
+
+    rng = np.random.default_rng(3)
+    A = rng.standard_normal((50, 6))
+    w, V, _ = spectral.principal(A)
+    a, theta = 3 * w ** 2, np.stack([(w[:, i] ** 3 - w[:, j] ** 3) / (w[:, i] - w[:, j]) for i, j in spectral.PAIRS], 1)
+    D = spectral.isotropic_derivative(V, a, theta)
+    B = np.stack([spectral.dyad(V[:, :, k], V[:, :, k]) for k in range(3)]
+                 + [np.sqrt(2.0) * spectral.dyad(V[:, :, i], V[:, :, j]) for i, j in spectral.PAIRS], axis=1)
+    ref = np.matmul(np.swapaxes(B, 1, 2) * np.concatenate([a, theta], 1)[:, None, :], B * spectral.WEIGHT)
+    assert np.abs(D - ref).max() < 1e-13 * np.abs(ref).max()
+
+    def F(x):
+        ww, _, P = spectral.principal(x)
+        return np.einsum("nk,nka->na", ww ** 3, P)
+
+    h = 1e-6
+    fd = np.stack([(F(A + h * np.eye(6)[c]) - F(A - h * np.eye(6)[c])) / (2 * h) for c in range(6)], -1)
+    assert np.abs(D - fd).max() < 1e-6 * np.abs(D).max()  # dF = D dA for stress-like Voigt dA

@@ -99,7 +99,7 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 @njit(cache=True, nogil=True, fastmath=True)
 def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
-               f, B, GS, GT):  # pragma: no cover
+               f, B, GS, GT, mode, sig_in, E_out):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
     covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
     (only the frame directions a point is tied in), the tied stresses σ = Ĉ E with the level's
@@ -107,9 +107,11 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
     internal force f (e, m) = Σ_k σ_k B_k = Σ_p Σ_K GS_K g_K with m = 3a (DOF index 3·a + k); on
     request the rows B (e, z, nT, m) (``want_b``; else B is unused) and the geometric operands
     GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
-    point p, the ties k and the directions J with σ_JK(p) = σ_k."""
+    point p, the ties k and the directions J with σ_JK(p) = σ_k. ``mode`` 0: as above; 1: only the
+    tie strains, into E_out (e, z, nT) (f gets zeros, nothing else is written); 2: the tie
+    stresses σ given as sig_in (e, z, nT), Lh unused (inelastic layers, :mod:`.inelastic_kernel`)."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
-    nT = Lh.shape[2]
+    nT = off[6]
     nd = d + 1
     na = 9 * nd
     m = 3 * na
@@ -185,8 +187,15 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
                             B[e, z, k0, 3 * a] = gi0 * dj + gj0 * di
                             B[e, z, k0, 3 * a + 1] = gi1 * dj + gj1 * di
                             B[e, z, k0, 3 * a + 2] = gi2 * dj + gj2 * di
+            if mode == 1:
+                for k in range(nT):
+                    E_out[e, z, k] = Ek[k]
+                continue
             # tied stresses σ = Ĉ E = L̂ (L̂ᵀ E)
-            if lower:
+            if mode == 2:
+                for k in range(nT):
+                    sig[k] = sig_in[e, z, k]
+            elif lower:
                 for W in range(nT):
                     yk[W] = 0.0
                 for k in range(nT):  # y = L̂ᵀ E row by row (contiguous rows of L̂)

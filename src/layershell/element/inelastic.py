@@ -1,10 +1,12 @@
 """Inelastic layers: the stress and tangent of a material law at every integration point of a
 layer, and reinforcement sheets (rebar, textile) inside a layer without extra DOFs.
 
-Bulk. The layer kernels' plain forms (:func:`.kernel.layer_response_reference`,
-:func:`.mitc.mitc_response_reference`) with the PK2 stress S and the tangent D = dS/dE of the law at
-the Green-Lagrange strain of each point (MITC9: the tied strain mapped to Cartesian axes) in
-place of S = C E: f = Σ Bᵀ S dV, K = Σ Bᵀ D B dV + the geometric term of S. The law sees the
+Bulk. The layer kernels with the PK2 stress S and the tangent D = dS/dE of the law at the
+Green-Lagrange strain of each point (MITC9: the tied strain mapped to Cartesian axes) in place of
+S = C E: f = Σ Bᵀ S dV, K = Σ Bᵀ D B dV + the geometric term of S; compiled
+(:mod:`.inelastic_kernel`, the law evaluated vectorised over the element range in between), or
+through the kernels' plain NumPy forms (:func:`.kernel.layer_response_reference`,
+:func:`.mitc.mitc_response_reference`; ``fast=False``, the independent check). The law sees the
 shell normal and two lengths per point for its crack band: the in-plane band
 h_in = 13/18 √(element area) (:data:`BAND_FRACTION`) and the thickness-point spacing
 h_z = H / (points through the layer).
@@ -228,8 +230,40 @@ def inelastic_block(X, H_below, H, d: int, material, law, sheets=(), n_thickness
     return InelasticBlock(base, law, h_in, h_z, normal, made)
 
 
-def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed):
-    """Forces ``(e, m)``, tangent ``(e, m, m)`` (None without ``tangent``) and trial state of a sheet."""
+def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed,
+                   fast: bool = True):
+    """Forces ``(e, m)``, tangent ``(e, m, m)`` (None without ``tangent``) and trial state of a sheet.
+
+    With b_q = (g_a·a)(F a)_i (the row dε/dU_ai at point q, m = 3a entries), c = E_t w, s = σ w:
+    K = Σ_q c_q b_q b_qᵀ + δ_ik Σ_q s_q (g_a·a)(g_b·a) as batched BLAS products per element
+    (``fast``), or literally as einsum (the independent check)."""
+    if not fast:
+        return _sheet_response_reference(sheet, U, nonlinear, tangent, sl, committed)
+    from . import _jit
+
+    g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
+    ga = np.matmul(g, a[..., None])[..., 0]  # (e, q, na): g_a·a
+    Ha = np.matmul(ga, U)  # (e, q, 3): ∇u a
+    eps = np.sum(Ha * a, axis=-1)
+    Fa = a + Ha if nonlinear else a
+    if nonlinear:
+        eps = eps + 0.5 * np.sum(Ha * Ha, axis=-1)
+    sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
+    e, q = eps.shape
+    trial = (trial, eps.ravel(), sig.ravel())
+    sw = sig.reshape(e, q) * w
+    B = (ga[..., :, None] * Fa[..., None, :]).reshape(e, q, -1)  # (e, q, m)
+    f = np.matmul(sw[:, None, :], B)[:, 0]
+    if not tangent:
+        return f, None, trial
+    K = np.matmul(B.transpose(0, 2, 1), B * (Et.reshape(e, q) * w)[..., None])
+    if nonlinear:
+        _jit.add_geometric(K, np.matmul(ga.transpose(0, 2, 1), ga * sw[..., None]))
+    return f, K, trial
+
+
+def _sheet_response_reference(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed):
+    """Plain einsum form of :func:`sheet_response` (the independent check)."""
     g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
     Ha = np.einsum("eai,eqaJ,eqJ->eqi", U, g, a)  # ∇u a
     eps = np.einsum("eqi,eqi->eq", Ha, a)
@@ -265,11 +299,13 @@ def extrapolated_state(block: InelasticBlock, previous: LayerState, current: Lay
 
 
 def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice,
-                       committed: LayerState, implex: LayerState | None = None):
+                       committed: LayerState, implex: LayerState | None = None, fast: bool = True):
     """Forces ``(e, m)``, tangent ``(e, m, m)`` and the trial :class:`LayerState` of the elements
     ``sl`` (a contiguous range) from their nodal vectors ``U (e, a, 3)`` and the committed state
     of the whole block; with ``implex`` (:func:`extrapolated_state`) the bulk law's stress takes
-    the damage of the extrapolated histories (IMPL-EX)."""
+    the damage of the extrapolated histories (IMPL-EX). ``fast``: the bulk through the compiled
+    kernel (:mod:`.inelastic_kernel`) and the sheets as batched products, else both through their
+    plain NumPy forms (the independent check)."""
     lo, hi, _ = sl.indices(block.h_in.shape[0])
     sl = slice(lo, hi)
     trial_bulk = None
@@ -289,12 +325,18 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
             ne = E.shape[0]
             return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
 
-        f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
+        if fast:
+            from .inelastic_kernel import bulk_response
+
+            f, K = bulk_response(block.base, U, nonlinear, tangent, sl, stress)
+        else:
+            f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
         trial_bulk = out["trial"]
     trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
-        fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, _take(committed.sheets[k], slice(lo * q, hi * q)))
+        fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, _take(committed.sheets[k], slice(lo * q, hi * q)),
+                                    fast)
         f = f + fs
         if tangent:
             K = K + Ks

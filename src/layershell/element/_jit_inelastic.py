@@ -1,0 +1,230 @@
+"""Compiled point loops of the inelastic layer kernel (Numba, ``cache=True``, GIL released).
+
+Imported lazily by :mod:`layershell.element.inelastic_kernel`. The material law is not evaluated
+here: these loops give the strain at the points, and from the law's stress S and tangent D there
+the internal force f = Σ Bᵀ S dV and the operands of K = Σ Bᵀ (D dV) B + the geometric term
+(``kernel.py``, ``mitc.py`` for the equations; D may be unsymmetric).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_VMAP = np.array([[0, 5, 4], [5, 1, 3], [4, 3, 2]], dtype=np.int64)  # Voigt index of (J, K)
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def full_strains(g, U, nonlinear, E):  # pragma: no cover
+    """Voigt Green-Lagrange strain (engineering shear) E (e, q, 6) of the full element at its
+    points from the basis gradients g (e, q, a, 3) and the nodal vectors U (e, a, 3)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    H = np.empty((3, 3))
+    for e in range(ne):
+        for q in range(nq):
+            for i in range(3):
+                for J in range(3):
+                    H[i, J] = 0.0
+            for a in range(na):
+                for i in range(3):
+                    u = U[e, a, i]
+                    for J in range(3):
+                        H[i, J] += u * g[e, q, a, J]
+            for V in range(6):
+                I = (0, 1, 2, 1, 0, 0)[V]
+                J = (0, 1, 2, 2, 2, 1)[V]
+                s = H[I, J] + H[J, I]
+                if nonlinear:
+                    s += H[0, I] * H[0, J] + H[1, I] * H[1, J] + H[2, I] * H[2, J]
+                E[e, q, V] = 0.5 * s if V < 3 else s
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
+    """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
+    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
+    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3).
+    As in ``_jit.point_terms``: B_W,(a i) = Σ_K g_aK Φ_WKi with Φ_WKi = Σ_J F_iJ [Voigt(J, K) = W]
+    and (D dV B)_W,(a i) = Σ_K g_aK Ψ_WKi with Ψ_WKi = Σ_J F_iJ (D dV)_W,Voigt(J, K)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    H = np.empty((3, 3))
+    F = np.empty((3, 3))
+    Sm = np.empty((3, 3))
+    P = np.empty((3, 3))
+    Phi = np.empty((6, 3, 3))
+    Psi = np.empty((6, 3, 3))
+    for e in range(ne):
+        for a in range(na):
+            for i in range(3):
+                f[e, a, i] = 0.0
+        for q in range(nq):
+            for i in range(3):
+                for J in range(3):
+                    H[i, J] = 0.0
+            if nonlinear:
+                for a in range(na):
+                    for i in range(3):
+                        u = U[e, a, i]
+                        for J in range(3):
+                            H[i, J] += u * g[e, q, a, J]
+            for I in range(3):
+                for J in range(3):
+                    F[I, J] = (1.0 if I == J else 0.0) + H[I, J]
+            w = dV[e, q]
+            Sm[0, 0], Sm[1, 1], Sm[2, 2] = S[e, q, 0] * w, S[e, q, 1] * w, S[e, q, 2] * w
+            Sm[1, 2] = Sm[2, 1] = S[e, q, 3] * w
+            Sm[0, 2] = Sm[2, 0] = S[e, q, 4] * w
+            Sm[0, 1] = Sm[1, 0] = S[e, q, 5] * w
+            for K in range(3):
+                for i in range(3):
+                    P[K, i] = Sm[K, 0] * F[i, 0] + Sm[K, 1] * F[i, 1] + Sm[K, 2] * F[i, 2]
+            for a in range(na):
+                g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                for i in range(3):
+                    f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
+            if want_x:
+                for W in range(6):
+                    for K in range(3):
+                        for i in range(3):
+                            Phi[W, K, i] = 0.0
+                            s = 0.0
+                            for J in range(3):
+                                V = _VMAP[J, K]
+                                s += F[i, J] * D[e, q, W, V]
+                                if V == W:
+                                    Phi[W, K, i] += F[i, J]
+                            Psi[W, K, i] = s * w
+                for W in range(6):
+                    for a in range(na):
+                        g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                        for i in range(3):
+                            X[e, q, W, a, i] = g0 * Phi[W, 0, i] + g1 * Phi[W, 1, i] + g2 * Phi[W, 2, i]
+                            Y[e, q, W, a, i] = g0 * Psi[W, 0, i] + g1 * Psi[W, 1, i] + g2 * Psi[W, 2, i]
+            if want_geo:
+                for a in range(na):
+                    g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
+                    for K in range(3):
+                        GS[e, a, q, K] = g0 * Sm[0, K] + g1 * Sm[1, K] + g2 * Sm[2, K]
+                        GT[e, a, q, K] = g[e, q, a, K]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
+    """Cartesian tied strain E (e, z, 9, 6) = T Ẽ at the Gauss points from the tie-space strains
+    Ek (e, z, nT): Ẽ_c(q) = Σ_t (w[c, q, t] + v[k]) E_k, k = off[c] + t (v (e, z, nT) the
+    consistency correction, zeros without it)."""
+    ne, nz = Ek.shape[0], Ek.shape[1]
+    Et = np.empty(6)
+    for e in range(ne):
+        for z in range(nz):
+            for q in range(9):
+                for c in range(6):
+                    s = 0.0
+                    for t in range(n[c]):
+                        k = off[c] + t
+                        s += (w[c, q, t] + v[e, z, k]) * Ek[e, z, k]
+                    Et[c] = s
+                for V in range(6):
+                    s = 0.0
+                    for c in range(6):
+                        s += T[e, z, q, V, c] * Et[c]
+                    E[e, z, q, V] = s
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # pragma: no cover
+    """Tie-space stress sig (e, z, nT) = Σ_q h_qᵀ S̃_q and, with ``tangent``, the unsymmetric tied
+    stiffness Ch (e, z, nT, nT) = Σ_q h_qᵀ C̃_q h_q from the law's Cartesian S (e, z, 9, 6) and
+    D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV. h_q = W_q + V: the tying functions W_q at Gauss
+    point q, given by their non-zeros (qn[q] entries: component qc, tie qk, value qw), and the
+    consistency correction V[c, k] = v[k] for c = comp[k] (the same at every q), so that
+    Ĉ = Ĉ₀ + Vᵀ R + L V + Vᵀ C0 V with Ĉ₀ = Σ_q W_qᵀ C̃_q W_q, R = Σ_q C̃_q W_q = Uᵀ Ĉ₀,
+    L = Σ_q W_qᵀ C̃_q = Ĉ₀ U and C0 = Σ_q C̃_q = Uᵀ Ĉ₀ U (U the component indicator: the tying
+    functions of a component sum to 1 at every point)."""
+    ne, nz, nT = sig.shape[0], sig.shape[1], sig.shape[2]
+    St = np.empty(6)
+    S0 = np.empty(6)
+    DT = np.empty((6, 6))
+    Ct = np.empty((6, 6))
+    C0 = np.empty((6, 6))
+    R = np.empty((6, nT))
+    L = np.empty((nT, 6))
+    Cl = np.empty((nT, nT))
+    sl = np.empty(nT)
+    for e in range(ne):
+        for z in range(nz):
+            sl[:] = 0.0
+            if tangent:
+                Cl[:] = 0.0
+            for q in range(9):
+                wq = dV[e, z, q]
+                Tq = T[e, z, q]
+                Sq = S[e, z, q]
+                for c in range(6):
+                    s = 0.0
+                    for V in range(6):
+                        s += Tq[V, c] * Sq[V]
+                    St[c] = s * wq
+                for j in range(qn[q]):
+                    sl[qk[q, j]] += qw[q, j] * St[qc[q, j]]
+                if not tangent:
+                    continue
+                Dq = D[e, z, q]
+                for V in range(6):
+                    for d in range(6):
+                        s = 0.0
+                        for W in range(6):
+                            s += Dq[V, W] * Tq[W, d]
+                        DT[V, d] = s * wq
+                for c in range(6):
+                    for d in range(6):
+                        s = 0.0
+                        for V in range(6):
+                            s += Tq[V, c] * DT[V, d]
+                        Ct[c, d] = s
+                for j1 in range(qn[q]):
+                    k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
+                    for j2 in range(qn[q]):
+                        Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
+            _correct(v[e, z], comp, tangent, sl, Cl, S0, R, L, C0)
+            for k in range(nT):
+                sig[e, z, k] = sl[k]
+            if not tangent:
+                continue
+            for k in range(nT):
+                for l in range(nT):
+                    Ch[e, z, k, l] = Cl[k, l]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
+    """Add the consistency correction ``v (nT,)`` of one level to its tie stresses ``sl`` and, with
+    ``tangent``, to its tied stiffness ``Cl`` (:func:`mitc_tie_stress`); nothing where v = 0."""
+    nT = sl.shape[0]
+    anyv = False
+    for k in range(nT):
+        if v[k] != 0.0:
+            anyv = True
+    if not anyv:
+        return
+    S0[:] = 0.0
+    for k in range(nT):  # the sums over the ties of a component: W_q reproduces constants
+        S0[comp[k]] += sl[k]
+    for k in range(nT):
+        sl[k] += v[k] * S0[comp[k]]
+    if not tangent:
+        return
+    R[:] = 0.0
+    L[:] = 0.0
+    C0[:] = 0.0
+    for k in range(nT):  # R = Uᵀ Ĉ₀, L = Ĉ₀ U, C0 = Uᵀ Ĉ₀ U (U the component indicator)
+        ck = comp[k]
+        for l in range(nT):
+            x = Cl[k, l]
+            R[ck, l] += x
+            L[k, comp[l]] += x
+            C0[ck, comp[l]] += x
+    for k in range(nT):
+        vk, ck = v[k], comp[k]
+        for l in range(nT):
+            vl, cl = v[l], comp[l]
+            Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl

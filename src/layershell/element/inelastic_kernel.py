@@ -1,0 +1,185 @@
+"""Compiled bulk kernel of inelastic layers: the layer kernels with a material law in place of S = C E.
+
+Three steps per element range: the strain at the points (compiled), the law's stress S and tangent
+D = dS/dE there (vectorised over all points of the range, one call), then f = Σ Bᵀ S dV and
+K = Σ Bᵀ (D dV) B + the geometric term of S (compiled point work and one BLAS product per element;
+D may be unsymmetric, so the general product instead of the elastic kernels' syrk with a Cholesky
+factor). Elements are split over the kernels' threads (:func:`.kernel.kernel_threads`) in the
+last step.
+
+* Full element (:class:`.kernel.LayerBlock`): E from the basis gradients and U at each point,
+  B from F and the gradients, K_mat = Xᵀ Y with X = B and Y = (D dV) B stacked over the points.
+* MITC9 (:class:`.mitc.MitcBlock`): the tie-space strains E_k of each level, the Cartesian tied
+  strain T Ẽ at the Gauss points (Ẽ_c(q) = Σ_t (h_t(q) + v_t) E_(c,t), the tying functions and
+  the consistency correction), then in the tie space σ_k = Σ_q (h_k(q) + v_k) (Tᵀ S dV)_c and
+  Ĉ = Σ_q h_qᵀ (Tᵀ D T dV) h_q (unsymmetric), f = Σ_k σ_k B_k and K_mat = Σ_z B_zᵀ Ĉ_z B_z.
+
+:func:`.kernel.layer_response_reference` / :func:`.mitc.mitc_response_reference` with the same
+``stress`` callable are the plain NumPy forms of both (tests/test_inelastic_layer.py).
+"""
+from __future__ import annotations
+
+from contextlib import nullcontext
+
+import numpy as np
+
+from ..threads import blas_single_thread
+from .kernel import LayerBlock, _pool, kernel_threads
+
+_SUB = 8  # elements per sub-block, as the elastic kernels (16 measured no faster): rows made and multiplied at once
+V_ROUNDOFF = 1e-13  # |v| of the tie correction below this is round-off (v = 0 on flat straight-edged elements)
+_NONE3 = np.empty((0, 0, 0))  # the compiled loops' array arguments that a call does not use
+_NONE4 = np.empty((0, 0, 0, 0))
+_NONE5 = np.empty((0, 0, 0, 0, 0))
+
+
+def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, stress):
+    """Forces ``(e, m)`` and tangent ``(e, m, m)`` (None without ``tangent``) of the elements ``sl``
+    (contiguous) of a layer block with ``stress(E) -> (S, D)``: E ``(e, P, 6)`` the Cartesian
+    Green-Lagrange strain at the block's P points (MITC9: tied; ``block.dV`` order), S ``(e, P, 6)``,
+    D ``(e, P, 6, 6)`` or None without ``tangent``."""
+    lo, hi, step = sl.indices(block.dV.shape[0])
+    if step != 1:
+        raise ValueError("bulk_response: the element range must be contiguous")
+    U = np.ascontiguousarray(U, dtype=np.float64)
+    nonlinear, tangent = bool(nonlinear), bool(tangent)
+    if isinstance(block, LayerBlock):
+        return _full(block, U, nonlinear, tangent, lo, hi, stress)
+    return _mitc(block, U, nonlinear, tangent, lo, hi, stress)
+
+
+def _threads(n_el: int, work, tangent: bool) -> None:
+    """``work(lo, hi)`` over element ranges, split over the kernel threads (BLAS single-threaded
+    for the tangent's products, as :func:`.kernel.layer_response`)."""
+    n_threads = min(kernel_threads(), max(1, n_el // _SUB))
+    with blas_single_thread() if tangent else nullcontext():
+        if n_threads == 1:
+            work(0, n_el)
+            return
+        bounds = np.linspace(0, n_el, n_threads + 1).astype(int)
+        jobs = [_pool(n_threads).submit(work, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+        for j in jobs:
+            j.result()
+
+
+def _law(stress, E, tangent: bool):
+    S, D = stress(E)
+    S = np.ascontiguousarray(S, dtype=np.float64)
+    D = np.ascontiguousarray(D, dtype=np.float64) if tangent else None
+    return S, D
+
+
+def _full(block: LayerBlock, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
+    from . import _jit, _jit_inelastic as jit
+
+    g, dV = block.gradphi[lo:hi], block.dV[lo:hi]
+    e, q, a = g.shape[:3]
+    m = 3 * a
+    E = np.empty((e, q, 6))
+    jit.full_strains(g, U, nonlinear, E)
+    S, D = _law(stress, E, tangent)
+    Dq = D if tangent else _NONE4
+    f = np.empty((e, a, 3))
+    K = np.empty((e, m, m)) if tangent else None
+    geo = tangent and nonlinear
+
+    def work(r0: int, r1: int) -> None:
+        for s in range(r0, r1, _SUB):
+            t = min(s + _SUB, r1)
+            nb = t - s
+            X = np.empty((nb, q, 6, a, 3)) if tangent else _NONE5
+            Y = np.empty_like(X)
+            GS = np.empty((nb, a, q, 3) if geo else (0, 0, 0, 0))
+            GT = np.empty_like(GS)
+            jit.full_terms(g[s:t], dV[s:t], S[s:t], Dq[s:t] if tangent else Dq, U[s:t], nonlinear, tangent, geo,
+                           f[s:t], X, Y, GS, GT)
+            if not tangent:
+                continue
+            np.matmul(X.reshape(nb, 6 * q, m).transpose(0, 2, 1), Y.reshape(nb, 6 * q, m), out=K[s:t])
+            if geo:
+                Kg = np.matmul(GS.reshape(nb, a, 3 * q), GT.reshape(nb, a, 3 * q).transpose(0, 2, 1))
+                _jit.add_geometric(K[s:t], Kg)
+
+    _threads(e, work, tangent)
+    return f.reshape(e, m), K
+
+
+def _mitc_args(block, lo: int, hi: int):
+    tie = block.tie
+    return (block.N, block.dN, block.thL[lo:hi], block.G[lo:hi], block.M[lo:hi], tie.pts, tie.off, tie.n, tie.dirs,
+            tie.ndir, tie.gn, tie.gk, tie.gJ)
+
+
+def _tying_nonzeros(tie):
+    """The non-zeros of the tying functions at each Gauss point q: their number (9,), component,
+    tie-space index and value (9, n) each (padded), and the component of each tie (nT,). The
+    tying points of E_11, E_22, E_23, E_13 lie on Gauss lines, so 13 of the 37 ties reach a point."""
+    key = id(tie)
+    if key in _NONZEROS and _NONZEROS[key][0] is tie:
+        return _NONZEROS[key][1]
+    nz = [[(c, int(tie.off[c] + t), float(tie.w[c, q, t])) for c in range(6) for t in range(int(tie.n[c]))
+           if tie.w[c, q, t] != 0.0] for q in range(9)]
+    width = max(len(r) for r in nz)
+    qn = np.array([len(r) for r in nz], np.int64)
+    qc, qk, qw = np.zeros((9, width), np.int64), np.zeros((9, width), np.int64), np.zeros((9, width))
+    for q, r in enumerate(nz):
+        for j, (c, k, w) in enumerate(r):
+            qc[q, j], qk[q, j], qw[q, j] = c, k, w
+    _NONZEROS[key] = (tie, (qn, qc, qk, qw, tie.component()))
+    return _NONZEROS[key][1]
+
+
+_NONZEROS: dict = {}  # id(tying) -> (tying, its non-zeros); the tyings are cached (mitc.tying)
+
+
+def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
+    from . import _jit, _jit_inelastic as jit
+
+    if block.T is None:
+        raise ValueError("bulk_response: the MITC9 block has no strain map T (build it with keep_map=True)")
+    tie = block.tie
+    e, nz = hi - lo, block.thL.shape[1]
+    nT = int(tie.off[-1])
+    a = 9 * (block.d + 1)
+    m = 3 * a
+    v = np.zeros((e, nz, nT))
+    if block.v is not None:  # levels whose correction is round-off (straight-edged flat elements): none
+        keep = np.abs(block.v[lo:hi]).max(axis=-1) > V_ROUNDOFF
+        v[keep] = block.v[lo:hi][keep]
+    T = block.T[lo:hi]
+    Ek = np.empty((e, nz, nT))
+    _jit.mitc_terms(*_mitc_args(block, lo, hi), _NONE4, U, block.d, nonlinear, False, False, False,
+                    np.empty((e, m)), _NONE4, _NONE3, _NONE3, 1, _NONE3, Ek)
+    Ec = np.empty((e, nz, 9, 6))
+    jit.mitc_gauss_strain(Ek, tie.w, v, tie.off, tie.n, T, Ec)
+    S, D = _law(stress, Ec.reshape(e, nz * 9, 6), tangent)
+    S = S.reshape(e, nz, 9, 6)
+    D = D.reshape(e, nz, 9, 6, 6) if tangent else _NONE5
+    dV = block.dV[lo:hi].reshape(e, nz, 9)
+    f = np.empty((e, m))
+    K = np.empty((e, m, m)) if tangent else None
+    geo = tangent and nonlinear
+    ncol = nz * int(tie.ndir.sum())
+    nzw = _tying_nonzeros(tie)
+
+    def work(r0: int, r1: int) -> None:
+        for s in range(r0, r1, _SUB):
+            t = min(s + _SUB, r1)
+            nb = t - s
+            sig = np.empty((nb, nz, nT))
+            Ch = np.empty((nb, nz, nT, nT)) if tangent else _NONE4
+            jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], *nzw, v[s:t], tangent, sig, Ch)
+            B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
+            GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))
+            GT = np.empty_like(GS)
+            _jit.mitc_terms(*_mitc_args(block, lo + s, lo + t), Ch, U[s:t], block.d, nonlinear, tangent, geo, False,
+                            f[s:t], B, GS, GT, 2, sig, _NONE3)
+            if not tangent:
+                continue
+            np.matmul(B.reshape(nb, nz * nT, m).transpose(0, 2, 1), np.matmul(Ch, B).reshape(nb, nz * nT, m),
+                      out=K[s:t])
+            if geo:
+                _jit.add_geometric(K[s:t], np.matmul(GS.transpose(0, 2, 1), GT))
+
+    _threads(e, work, tangent)
+    return f, K
