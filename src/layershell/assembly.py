@@ -498,6 +498,8 @@ class Assembler:
         for i, st in self.committed.items():
             out.update(st.to_dict(f"block{i}"))
             out.update(self.previous[i].to_dict(f"previous{i}"))
+        if out:
+            out["implex_times"] = np.array(self.times, float)
         return out
 
     def set_material_state(self, arrays: dict) -> None:
@@ -505,6 +507,11 @@ class Assembler:
         is missing or of another shape)."""
         self.committed = {i: st.load(arrays, f"block{i}") for i, st in self.committed.items()}
         self.previous = {i: st.load(arrays, f"previous{i}") for i, st in self.previous.items()}
+        if self.committed:
+            if "implex_times" not in arrays:
+                raise KeyError("implex_times")
+            self.times = tuple(float(t) for t in np.asarray(arrays["implex_times"]))
+            self.ratio = 1.0
         self.trial = {i: st.copy() for i, st in self.committed.items()}
         self._extrapolate()
         self._publish()

@@ -51,7 +51,7 @@ X_TOL = 1e-13
 KAPPA_SCAN = (1e-8, 1.0, 400)
 
 CURVES = ("parabola-rectangle", "sargin", "linear")
-TENSION = ("brittle", "softening", "none")
+TENSION = ("brittle", "softening", "exponential", "none")
 
 
 def _positive(name: str, value, fix: str) -> None:
@@ -73,6 +73,8 @@ class Concrete:
     n: float = 2.0
     tension: str = "brittle"
     eps_tu: float | None = None
+    G_F: float | None = None  # tension = "exponential": fracture energy (force/length) ...
+    band: float | None = None  # ... over the crack band (length)
 
     def __post_init__(self):
         _positive("f_c", self.f_c, "give the compressive strength as a positive stress")
@@ -85,6 +87,10 @@ class Concrete:
             raise MaterialError(f"'tension' = {self.tension!r} is not known; use one of {TENSION}")
         if self.tension != "none":
             _positive("f_ct", self.f_ct, "give the tensile strength, or tension = 'none'")
+        if self.tension == "exponential" and not ((self.G_F or 0) > 0 and (self.band or 0) > 0
+                                                  and self.band < 2 * self.G_F * self.E_c / self.f_ct ** 2):
+            raise MaterialError("tension = 'exponential' needs a positive 'G_F' and a crack 'band' below the "
+                                "snap-back limit 2 G_F E_c / f_ct²")
         if self.tension == "softening" and not (self.eps_tu or 0) > self.f_ct / self.E_c:
             raise MaterialError("'eps_tu' must exceed the cracking strain f_ct/E_c for "
                                 "tension = 'softening'; give the strain at which tension ends")
@@ -118,6 +124,9 @@ class Concrete:
         rising = self.E_c * eps
         if self.tension == "brittle":
             return np.where(eps <= eps_cr, rising, 0.0)
+        if self.tension == "exponential":  # Oliver (1989): G_F / band dissipated per volume
+            A = 1.0 / (self.G_F * self.E_c / (self.band * self.f_ct ** 2) - 0.5)
+            return np.where(eps <= eps_cr, rising, self.f_ct * np.exp(A * (1.0 - np.maximum(eps, eps_cr) / eps_cr)))
         soft = self.f_ct * np.clip((self.eps_tu - eps) / (self.eps_tu - eps_cr), 0.0, 1.0)
         return np.where(eps <= eps_cr, rising, soft)
 

@@ -1,0 +1,255 @@
+"""Concrete layers with reinforcement through the whole program: model input, IMPL-EX
+integration, restart, and structural references.
+
+References: a plane-sections analysis of the RC section (layershell.analytic.rc_section, its own
+tests against hand calculations) with the same uniaxial laws; the fracture energy G_F of the
+concrete law (a crack through a section of area A dissipates G_F A); elastic beam theory."""
+from __future__ import annotations
+
+import dataclasses
+import json
+
+import numpy as np
+import pytest
+
+from helpers import stopped_and_restarted
+from layershell.analytic.rc_section import (Concrete, RCSection, Rebar, cracking_moment, transformed_uncracked,
+                                           ultimate_moment, yield_moment)
+from layershell.element.inelastic import BAND_FRACTION
+from layershell.io.build import build, parse
+from layershell.io.errors import InputError
+from layershell.laws import ConcreteLaw, SteelLaw
+from layershell.runner import run
+
+C30 = ConcreteLaw.from_class(30.0, 1.0, 1e-3)  # N, mm
+B500 = SteelLaw.from_grade("B500B", 1.0)
+
+
+def strip_model(nx: int = 15, n: int = 200, value: float = -40.0, extra: str = "", rebar: str | None = None) -> str:
+    """Half of a simply supported RC slab strip (span 3 m, h = 160 mm, 5 Ø10 per metre at
+    d = 130 mm) in four-point bending: the line load at x = 1 m is a prescribed deflection of the
+    top face, symmetry at midspan (x = 1.5 m); square elements (width 1500/nx)."""
+    w = 1500.0 / nx
+    rebar = rebar or ('[{material = "b500", height = 30.0, bar_diameter = 10.0, spacing = 200.0, '
+                      'direction = [1, 0, 0]}]')
+    return f"""
+[model]
+units = "N, mm"
+nonlinear = false
+thickness_points = 8
+
+[mesh]
+type = "rectangle"
+lx = 1500.0
+ly = {w}
+nx = {nx}
+ny = 1
+
+[materials.c30]
+type = "concrete"
+strength_class = "C30/37"
+
+[materials.b500]
+type = "steel"
+grade = "B500B"
+
+[[layers]]
+name = "slab"
+material = "c30"
+thickness = 160.0
+directors = 2
+reinforcement = {rebar}
+
+[[supports]]
+type = "fix"
+where = "near(x, 0)"
+components = ["z"]
+
+[[supports]]
+type = "symmetry"
+where = "near(x, 1500)"
+normal = [1, 0, 0]
+
+[[supports]]
+type = "fix"
+where = "near(x, 0) and near(y, 0)"
+components = ["y"]
+
+[[supports]]
+type = "fix"
+where = "near(x, 1000)"
+face = "top"
+components = ["z"]
+value = [{value}]
+
+[steps]
+n = {n}
+tolerance = 1e-6
+{extra}
+
+[[probes]]
+name = "R"
+quantity = "reaction"
+where = "near(x, 0)"
+component = "z"
+
+[[probes]]
+name = "w"
+quantity = "displacement"
+point = [1500, 0, 0]
+component = "z"
+scale = -1.0
+
+[[probes]]
+name = "sigma_s"
+quantity = "rebar_stress"
+layer = "slab"
+
+[[probes]]
+name = "crack"
+quantity = "crack_width"
+layer = "slab"
+"""
+
+
+def section(tension: str, band: float) -> RCSection:
+    """The strip's section per metre with the laws of the model (Sargin in compression, the
+    concrete's tension law, B500B with its hardening and rupture)."""
+    c = Concrete(f_c=C30.f_c, f_ct=C30.f_ct, E_c=C30.E, curve="sargin", eps_c1=C30.eps_c1, tension=tension,
+                 G_F=C30.G_F, band=band)
+    return RCSection(h=160.0, b=1000.0, concrete=c,
+                     rebars=(Rebar(depth=130.0, area=5 * np.pi * 25.0, E_s=B500.E, f_y=B500.f_y, E_h=B500.E_h,
+                                   eps_su=B500.eps_u),))
+
+
+def moments(res, width: float) -> np.ndarray:
+    """Midspan moment per metre width (kNm/m) of each step: the support reaction × 1 m."""
+    return np.array([r["probes"]["R"] for r in res.summary["steps"]]) * 1000.0 / width * 1e-3
+
+
+# ------------------------------------------------------------------------------ model input
+def test_strength_class_in_other_units_gives_the_same_concrete():
+    kN_m = ConcreteLaw.from_class(30.0, 1e-3, 1.0)
+    assert kN_m.f_c == pytest.approx(C30.f_c * 1e3) and kN_m.E == pytest.approx(C30.E * 1e3)
+    assert kN_m.G_F == pytest.approx(C30.G_F)  # N/mm = kN/m
+    spec = build(parse(strip_model(6, 4).replace('units = "N, mm"', 'units = "kN, m"')))
+    law = spec.model.layers[0].law
+    assert law.f_c == pytest.approx(38e3) and law.f_ct == pytest.approx(C30.f_ct * 1e3)
+    assert spec.model.layers[0].material.E1 == pytest.approx(law.E)
+    r = spec.model.layers[0].reinforcement[0]
+    assert r.area == pytest.approx(np.pi * 25.0 / 200.0) and r.height == 30.0
+
+
+@pytest.mark.parametrize("edit, field, fix", [
+    (('strength_class = "C30/37"', ""), "materials.c30", "strength_class"),
+    (('strength_class = "C30/37"', 'strength_class = "C30"'), "materials.c30.strength_class", "C30/37"),
+    (('units = "N, mm"', 'units = ""'), "materials.c30", "units"),
+    (('height = 30.0', 'height = 170.0'), "reinforcement[0].height", "between 0"),
+    (('material = "c30"\nthickness', 'material = "b500"\nthickness'), "layers[0].material", "reinforcement"),
+    (('{material = "b500"', '{material = "c30"'), "reinforcement[0].material", "steel"),
+    (('{material = "b500"', '{material = "rebar"'), "reinforcement[0].material", "unknown material"),
+    (('bar_diameter = 10.0, spacing = 200.0', 'bar_diameter = 10.0'), "reinforcement", "spacing"),
+    (('grade = "B500B"', 'grade = "S235"'), "materials.b500", "B500"),
+])
+def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
+    text = strip_model(6, 4)
+    assert edit[0] in text
+    with pytest.raises((InputError, ValueError)) as err:
+        build(parse(text.replace(*edit)))
+    msg = str(err.value)
+    assert field in msg and fix in msg, msg
+
+
+def test_crack_width_probe_needs_a_concrete_layer():
+    text = strip_model(6, 4).replace('type = "concrete"\nstrength_class = "C30/37"',
+                                     'type = "isotropic"\nE = 30000.0\nnu = 0.2')
+    with pytest.raises(InputError, match=r"probes\[3\].layer.*not of a concrete"):
+        build(parse(text))
+
+
+# ------------------------------------------------------------------------------ IMPL-EX
+def test_implex_response_with_the_committed_damage_is_the_secant_response():
+    """Acting with the committed histories, IMPL-EX gives σ = (1 − d⁺) σ̄⁺ + (1 − d⁻) σ̄⁻ of the
+    committed damage; its tangent is the derivative at that frozen damage (central differences),
+    and its trial state is the plain update's."""
+    rng = np.random.default_rng(4)
+    n = 40
+    h, hz, nrm = np.full(n, 50.0), np.full(n, 20.0), np.tile([0.0, 0.0, 1.0], (n, 1))
+    eps0 = 4e-4 * rng.standard_normal((n, 6))
+    _, _, c = C30.response(eps0, C30.state(n), h, hz, nrm)  # a damaged committed state
+    eps = eps0 + 5e-5 * rng.standard_normal((n, 6))
+    S, D, tr = C30.response(eps, c, h, hz, nrm, implex=c)
+    _, _, tr_plain = C30.response(eps, c, h, hz, nrm)
+    for f in dataclasses.fields(tr):
+        assert np.array_equal(getattr(tr, f.name), getattr(tr_plain, f.name))
+    dt, _, _ = C30.damage_tension(c.r_t, c.h_t)
+    assert np.any(dt > 0.1)
+    Dfd = np.empty_like(D)
+    for j in range(6):
+        e = np.zeros(6)
+        e[j] = 1e-9
+        Dfd[:, :, j] = (C30.response(eps + e, c, h, hz, nrm, False, implex=c)[0]
+                        - C30.response(eps - e, c, h, hz, nrm, False, implex=c)[0]) / 2e-9
+    assert np.abs(D - Dfd).max() < 1e-5 * np.abs(D).max()
+    assert C30.implex_error(tr, c).max() >= 0.0
+
+
+def test_implex_extrapolates_linearly_in_pseudo_time():
+    n = 3
+    a, b = C30.state(n), C30.state(n)
+    a = dataclasses.replace(a, r_t=np.array([1.0, 2.0, 3.0]))
+    b = dataclasses.replace(b, r_t=np.array([2.0, 2.0, 3.5]))
+    assert np.allclose(C30.extrapolate(a, b, 0.5).r_t, [2.5, 2.0, 3.75])
+
+
+# ------------------------------------------------------------------------------ the RC strip
+def test_strip_cracks_then_yields_and_restarts_exactly(tmp_path):
+    """Through cracking and yielding on a coarse mesh: elastic stiffness against beam theory,
+    the events in order, bar stress and crack width growing; a run stopped after step 12 and
+    restarted ends where the uninterrupted one does."""
+    text = strip_model(6, 24, value=-24.0)
+    spec = build(parse(text))
+    res = run(spec, tmp_path / "whole", write_vtu=False)
+    assert res.converged
+    s = res.summary
+    assert 0 < s["first_cracking_step"] < s["first_yield_step"]
+    M = moments(res, 250.0)
+    w = np.array([r["probes"]["w"] for r in res.summary["steps"]])
+    # elastic (Timoshenko beam, per mm width, N and mm): two loads P = M/a at a = 1 m of L = 3 m,
+    # w = M (3L² − 4a²)/(24 E I_I) + M/(κ G h) at midspan, I_I of the transformed section
+    I_I = transformed_uncracked(section("none", 50.0))[1] / 1000.0
+    m = M[0] * 1e3  # N·mm/mm
+    w_ref = m * (3 * 3000.0 ** 2 - 4 * 1000.0 ** 2) / (24 * C30.E * I_I) + m / (5 / 6 * C30.E / 2.4 * 160.0)
+    assert w[0] == pytest.approx(w_ref, rel=0.02)  # 250 mm elements: +1.0 %
+    sig = np.array([r["probes"]["sigma_s"] for r in res.summary["steps"]])
+    assert sig[0] < 0.1 * B500.f_y and B500.f_y <= sig[-1] < B500.f_y + B500.E_h * 0.05
+    dis = np.array([r["dissipated_material"] for r in res.summary["steps"]])
+    assert np.all(np.diff(dis) >= -1e-9) and dis[-1] > 0
+    part, again = stopped_and_restarted(spec, tmp_path / "part", 12)
+    assert part.interrupted and again.converged
+    assert np.allclose(again.u, res.u, rtol=0, atol=1e-9 * np.abs(res.u).max())
+    assert again.summary["first_yield_step"] == s["first_yield_step"]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("nx", [15, 30, 60])
+def test_strip_against_the_section_analysis(nx, tmp_path):
+    """On three meshes: the moment at first cracking against the section's at which the
+    outermost thickness point reaches f_ct; the moment at first yield between the bare cracked
+    section's and the section with the same tension softening over the same crack band (a
+    smeared crack localises into the band of one element, which the section does not); the
+    largest moment within 3 % of the section's ultimate moment (bar rupture)."""
+    res = run(build(parse(strip_model(nx))), tmp_path, write_vtu=False)
+    width = 1500.0 / nx
+    M = moments(res, width)
+    s = res.summary
+    band = BAND_FRACTION * width
+    zeta = np.polynomial.legendre.leggauss(8)[0].max()  # the outermost of 8 Gauss points
+    M_cr = cracking_moment(section("exponential", band))[0] / 1e6 / zeta
+    k = s["first_cracking_step"] - 1
+    assert M[k - 1] < M_cr * 1.03 and M[k] > M_cr * 0.97
+    j = s["first_yield_step"] - 1
+    lo, hi = yield_moment(section("none", band))[0] / 1e6, yield_moment(section("exponential", band))[0] / 1e6
+    assert lo * 0.99 < M[j] < hi * 1.01
+    M_u = ultimate_moment(section("exponential", band))[0] / 1e6
+    assert M.max() == pytest.approx(M_u, rel=0.03)
