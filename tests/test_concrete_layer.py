@@ -232,14 +232,15 @@ def test_strip_cracks_then_yields_and_restarts_exactly(tmp_path):
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("nx", [15, 30, 60])
+@pytest.mark.parametrize("nx", [6, 12, 15])
 def test_strip_against_the_section_analysis(nx, tmp_path):
-    """On three meshes: the moment at first cracking against the section's at which the
-    outermost thickness point reaches f_ct; the moment at first yield between the bare cracked
-    section's and the section with the same tension softening over the same crack band (a
-    smeared crack localises into the band of one element, which the section does not); the
-    largest moment within 3 % of the section's ultimate moment (bar rupture)."""
-    res = run(build(parse(strip_model(nx))), tmp_path, write_vtu=False)
+    """On three meshes (250, 125, 100 mm elements) to a deflection of 20 mm: the moment at first
+    cracking brackets the section's at which the outermost of the 8 thickness points reaches
+    f_ct; the moment at first yield of the bars lies between that of the bare cracked section
+    and that of the section with the same tension softening over the element's crack band (the
+    FE's cracks hold some tension between the two)."""
+    res = run(build(parse(strip_model(nx, 100, -20.0))), tmp_path, write_vtu=False)
+    assert res.converged
     width = 1500.0 / nx
     M = moments(res, width)
     s = res.summary
@@ -247,9 +248,88 @@ def test_strip_against_the_section_analysis(nx, tmp_path):
     zeta = np.polynomial.legendre.leggauss(8)[0].max()  # the outermost of 8 Gauss points
     M_cr = cracking_moment(section("exponential", band))[0] / 1e6 / zeta
     k = s["first_cracking_step"] - 1
-    assert M[k - 1] < M_cr * 1.03 and M[k] > M_cr * 0.97
+    assert M[k - 1] < M_cr < M[k]
     j = s["first_yield_step"] - 1
     lo, hi = yield_moment(section("none", band))[0] / 1e6, yield_moment(section("exponential", band))[0] / 1e6
-    assert lo * 0.99 < M[j] < hi * 1.01
-    M_u = ultimate_moment(section("exponential", band))[0] / 1e6
-    assert M.max() == pytest.approx(M_u, rel=0.03)
+    assert lo < M[j] < hi
+
+
+def beam_model(nx: int) -> str:
+    """A plain concrete beam (C30/37, span 400 mm, depth 100 mm) in three-point bending, the
+    midspan deflection prescribed on the top face (1 mm at λ = 1); nx odd, so that an element
+    is centred at midspan; square elements (width 400/nx)."""
+    return f"""
+[model]
+units = "N, mm"
+nonlinear = false
+thickness_points = 8
+
+[mesh]
+type = "rectangle"
+lx = 400.0
+ly = {400.0 / nx}
+nx = {nx}
+ny = 1
+
+[materials.c30]
+type = "concrete"
+strength_class = "C30/37"
+
+[[layers]]
+name = "beam"
+material = "c30"
+thickness = 100.0
+directors = 2
+
+[[supports]]
+type = "fix"
+where = "near(x, 0) or near(x, 400)"
+components = ["z"]
+
+[[supports]]
+type = "fix"
+where = "near(x, 0) and near(y, 0)"
+components = ["x", "y"]
+
+[[supports]]
+type = "fix"
+where = "near(x, 400) and near(y, 0)"
+components = ["y"]
+
+[[supports]]
+type = "fix"
+where = "near(x, 200)"
+face = "top"
+components = ["z"]
+value = [-1.0]
+
+[steps]
+n = 200
+tolerance = 1e-6
+
+[[probes]]
+name = "P"
+quantity = "reaction"
+where = "near(x, 200)"
+component = "z"
+scale = -1.0
+"""
+
+
+@pytest.mark.slow
+def test_plain_beam_is_objective_on_three_meshes(tmp_path):
+    """Three-point bending of a plain beam on elements of 44, 24 and 12 mm: the peak load per
+    width within 3 % of the three's mean, and the energy dissipated to complete failure within
+    6 % of G_F × the ligament (the crack through the depth, per width)."""
+    peaks, energies = [], []
+    for nx in (9, 17, 33):
+        res = run(build(parse(beam_model(nx))), tmp_path / str(nx), write_vtu=False)
+        assert res.converged
+        width = 400.0 / nx
+        steps = res.summary["steps"]
+        peaks.append(max(r["probes"]["P"] for r in steps) / width)
+        assert steps[-1]["probes"]["P"] / width < 0.01 * peaks[-1]  # separated
+        energies.append(steps[-1]["dissipated_material"] / width)
+    peaks = np.array(peaks)
+    assert np.all(np.abs(peaks / peaks.mean() - 1) < 0.03), peaks
+    assert np.all(np.abs(np.array(energies) / (C30.G_F * 100.0) - 1) < 0.06), energies
