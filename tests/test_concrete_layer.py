@@ -333,3 +333,18 @@ def test_plain_beam_is_objective_on_three_meshes(tmp_path):
     peaks = np.array(peaks)
     assert np.all(np.abs(peaks / peaks.mean() - 1) < 0.03), peaks
     assert np.all(np.abs(np.array(energies) / (C30.G_F * 100.0) - 1) < 0.06), energies
+
+
+def test_surface_file_holds_crack_widths_and_bar_stresses(tmp_path):
+    """The ParaView surface file of a cracked strip: per element the largest crack width and bar
+    stress, the same maxima as the probes."""
+    import meshio
+
+    res = run(build(parse(strip_model(6, 6, value=-6.0))), tmp_path, write_vtu=True)
+    last = sorted(tmp_path.glob("surface_*.vtu"))[-1]
+    m = meshio.read(last)
+    w = m.cell_data["crack_width_slab"][0]
+    sig = m.cell_data["rebar_stress_slab_b500_1"][0]
+    probes = res.summary["steps"][-1]["probes"]
+    assert np.nanmax(w) == pytest.approx(probes["crack"]) and np.nanmax(sig) == pytest.approx(probes["sigma_s"])
+    assert np.nanmax(w) > 0 and np.all(np.isfinite(sig))

@@ -114,6 +114,29 @@ def _write_vtu(path: Path, mesh) -> None:
 # ----------------------------------------------------------------------------- meshes
 
 
+def material_cell_fields(model: Model) -> dict[str, np.ndarray]:
+    """Per element of the surface mesh: the largest crack width of each concrete layer
+    (``crack_width_<layer>``) and the largest bar/yarn stress of each reinforcement sheet
+    (``rebar_stress_<layer>_<sheet>``) in the committed state; NaN where the layer is absent."""
+    from .element.inelastic import layer_point_values
+
+    out: dict[str, np.ndarray] = {}
+    n = model.mesh.n_elements
+    for k, ly in enumerate(model.layers):
+        fields = [("crack_width", None, f"crack_width_{ly.name}")] if ly.law is not None else []
+        fields += [("rebar_stress", r.name, f"rebar_stress_{ly.name}_{r.name}".replace(" ", "_"))
+                   for r in ly.reinforcement]
+        for quantity, sheet, name in fields:
+            v, el = layer_point_values(model, k, quantity, sheet)
+            cell = np.full(n, np.nan)
+            if v.size:
+                cell[:] = -np.inf
+                np.maximum.at(cell, el, v)
+                cell[np.isneginf(cell)] = np.nan
+            out[name] = cell
+    return out
+
+
 def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
     """meshio.Mesh of the reference surface with nodal director displacements."""
     import meshio
@@ -127,6 +150,7 @@ def surface_mesh(model: Model, dm: DofMap, u_full: np.ndarray):
         "element_id": [np.arange(mesh.n_elements, dtype=np.int64)],
         "stack": [np.asarray(model.element_stack, dtype=np.int64)],
     }
+    cell_data.update({k: [v] for k, v in material_cell_fields(model).items()})
     return meshio.Mesh(
         np.asarray(mesh.nodes, float),
         [("quad9", np.asarray(mesh.elements, dtype=np.int64))],
