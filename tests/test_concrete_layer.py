@@ -348,3 +348,13 @@ def test_surface_file_holds_crack_widths_and_bar_stresses(tmp_path):
     probes = res.summary["steps"][-1]["probes"]
     assert np.nanmax(w) == pytest.approx(probes["crack"]) and np.nanmax(sig) == pytest.approx(probes["sigma_s"])
     assert np.nanmax(w) > 0 and np.all(np.isfinite(sig))
+
+
+def test_load_displacement_figure_marks_cracking_and_yielding():
+    from layershell.plots import event_steps
+
+    summary = {"steps": [{"step": i, "load_factor": 0.1 * i} for i in range(1, 8)], "first_cracking_step": 2,
+               "first_yield_step": 6, "first_delamination_load_factor": 0.45}
+    marks = event_steps(summary)
+    assert marks["first cracking"][0] == 1 and marks["first yielding"][0] == 5 and marks["first debonding"][0] == 4
+    assert "first rupture" not in marks

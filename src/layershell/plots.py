@@ -158,12 +158,34 @@ def load_axis(model: Model) -> tuple[str, float]:
     return axis_label(f"{name} λ × {vmax:g}", Units.parse(model.units).length), vmax
 
 
+#: summary keys of the events the load-displacement figures mark, with their labels and markers
+EVENT_MARKS = (("first_cracking_step", "first cracking", "^"), ("first_yield_step", "first yielding", "s"),
+               ("first_crushing_step", "first crushing", "v"), ("first_rupture_step", "first rupture", "X"),
+               ("first_delamination_step", "first debonding", "D"))
+
+
+def event_steps(summary: dict) -> dict[str, tuple[int, str]]:
+    """label -> (index into the step records, marker) of the events the run saw."""
+    steps = [r["step"] for r in summary.get("steps", [])]
+    out = {}
+    for key, label, marker in EVENT_MARKS:
+        step = summary.get(key)
+        if step is None and key == "first_delamination_step" and summary.get("first_delamination_load_factor") is not None:
+            lam = summary["first_delamination_load_factor"]
+            step = next((r["step"] for r in summary.get("steps", []) if r["load_factor"] >= lam), None)
+        if step in steps:
+            out[label] = (steps.index(step), marker)
+    return out
+
+
 def plot_load_displacement(path, load_factors, probes: dict[str, list[float]], units: str = "",
                            probe_units: dict[str, str | None] | None = None,
-                           load: tuple[str, float] = ("load factor λ", 1.0)) -> Path:
+                           load: tuple[str, float] = ("load factor λ", 1.0),
+                           events: dict[str, tuple[int, str]] | None = None) -> Path:
     """Load-displacement curves: one subplot per probe, probe value on x, ``load = (label, factor)``
     × the load factor on y (:func:`load_axis`: the prescribed displacement under displacement
-    control); x axes labelled with ``probe_units[name]``, else ``units``."""
+    control); x axes labelled with ``probe_units[name]``, else ``units``; ``events`` (label ->
+    (step index, marker), :func:`event_steps`) marked on every curve."""
     probe_units = probe_units or {}
     lam = load[1] * np.asarray(load_factors, float)
     n = max(len(probes), 1)
@@ -175,6 +197,11 @@ def plot_load_displacement(path, load_factors, probes: dict[str, list[float]], u
         v = np.asarray(values, float)
         m = min(v.size, lam.size)
         ax.plot(v[:m], lam[:m], "o-", ms=3, lw=1.2)
+        for label, (i, marker) in (events or {}).items():
+            if i < m:
+                ax.plot(v[i], lam[i], marker, ms=8, mfc="none", mew=1.5, label=label)
+        if events:
+            ax.legend(fontsize=7, loc="best")
         ax.set_xlabel(axis_label(name, probe_units.get(name, units)))
         ax.set_ylabel(load[0])
         ax.set_title(name)
@@ -648,11 +675,12 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
     load = load_axis(model)
     if names:
         series = {n: [s["probes"][n] for s in steps] for n in names}
-        plot_load_displacement(out / "load_displacement.png", lam, series, "", units_of, load)
-        files["load_displacement.png"] = {"probes": names}
+        marks = event_steps(summary)
+        plot_load_displacement(out / "load_displacement.png", lam, series, "", units_of, load, marks)
+        files["load_displacement.png"] = {"probes": names, "events": sorted(marks)}
         for n in names:
             f = f"load_displacement_{_safe(n)}.png"
-            plot_load_displacement(out / f, lam, {n: series[n]}, "", units_of, load)
+            plot_load_displacement(out / f, lam, {n: series[n]}, "", units_of, load, marks)
             files[f] = {"probe": n, "range": (float(min(series[n])), float(max(series[n])))}
     for pl in getattr(spec.source, "plots", []):
         xs, ys = ([s["probes"][n] for s in steps] for n in (pl.x, pl.y))
