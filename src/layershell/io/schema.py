@@ -370,7 +370,9 @@ Material = Annotated[Union[Isotropic, OrthotropicMat, ConcreteMat, SteelMat, Tex
 
 class ReinforcementDef(Strict):
     material: str = Field(description="name of a [materials.NAME] table of type 'steel' or 'textile'")
-    height: PositiveFloat = Field(description="height of the sheet above the layer's bottom face (length)")
+    height: PositiveFloat = Field(description=(
+        "distance of the sheet from the layer's bottom face, the face towards the reference face (length); where "
+        "the mesh normal points down (normal = '-z') that face is the layer's physical top"))
     area: PositiveFloat | None = Field(None, description=(
         "cross-section area per unit width (length²/length); or give bar_diameter and spacing"))
     bar_diameter: PositiveFloat | None = Field(None, description="bar diameter (length), with spacing")
