@@ -150,6 +150,9 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('{material = "b500"', '{material = "rebar"'), "reinforcement[0].material", "unknown material"),
     (('bar_diameter = 10.0, spacing = 200.0', 'bar_diameter = 10.0'), "reinforcement", "spacing"),
     (('grade = "B500B"', 'grade = "S235"'), "materials.b500", "B500"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "refine the mesh"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = -0.1'), "materials.c30.G_F", "greater than 0"),
+    (('bar_diameter = 10.0, spacing = 200.0', 'area = 0.0'), "reinforcement[0].area", "greater than 0"),
 ])
 def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
     text = strip_model(6, 4)

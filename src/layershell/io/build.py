@@ -936,6 +936,29 @@ def _reinforcement(ld: schema.LayerDef, i: int, laws: dict) -> tuple[Reinforceme
     return tuple(out)
 
 
+def _check_crack_band(model: Model) -> None:
+    """The crack bands of every concrete layer stay below the snap-back limit of its softening
+    (:meth:`layershell.laws.ConcreteLaw.check_band`), checked before the analysis."""
+    from ..element.geometry import surface_points
+    from ..element.inelastic import BAND_FRACTION
+    from ..element.quadrature import gauss_2d
+
+    pts, w2 = gauss_2d(3)
+    for k, ly in enumerate(model.layers):
+        if ly.law is None or not hasattr(ly.law, "check_band"):
+            continue
+        el = np.flatnonzero([k in model.stacks[si] for si in model.element_stack])
+        conn = model.mesh.elements[el]
+        sp = surface_points(model.mesh.nodes[conn], pts[:, 0], pts[:, 1])
+        h_in = BAND_FRACTION * np.sqrt(np.sum(sp.sqrtA * w2, axis=1))
+        nz = max(model.n_thickness, ly.directors + (1 if model.element == "mitc" else 0))
+        h_z = ly.thickness[conn].max(axis=1) / nz
+        try:
+            ly.law.check_band(h_in, h_z, ly.name)
+        except MaterialError as exc:
+            raise InputError(f"'layers[{k}]': {exc}") from None
+
+
 def _check_reinforcement(model: Model, mf: schema.ModelFile) -> None:
     """Each sheet lies inside its layer's thickness wherever the layer exists."""
     present = model.layers_present()
@@ -1059,6 +1082,7 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
         raise InputError(f"'stacks': {exc}") from None
     _check_slender(model)
     _check_reinforcement(model, mf)
+    _check_crack_band(model)
     first = stacks[0][0]
     if mf.mesh.surface == "middle":
         m.nodes = m.nodes - 0.5 * model.total_thickness()[:, None] * nodal_normals(m)
