@@ -132,12 +132,19 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     kN_m = ConcreteLaw.from_class(30.0, 1e-3, 1.0)
     assert kN_m.f_c == pytest.approx(C30.f_c * 1e3) and kN_m.E == pytest.approx(C30.E * 1e3)
     assert kN_m.G_F == pytest.approx(C30.G_F)  # N/mm = kN/m
-    spec = build(parse(strip_model(6, 4).replace('units = "N, mm"', 'units = "kN, m"')))
+    text = strip_model(6, 4)
+    for a, b in (('units = "N, mm"', 'units = "kN, m"'), ("lx = 1500.0", "lx = 1.5"), ("ly = 250.0", "ly = 0.25"),
+                 ("thickness = 160.0", "thickness = 0.16"), ("height = 30.0", "height = 0.03"),
+                 ("bar_diameter = 10.0, spacing = 200.0", "bar_diameter = 0.01, spacing = 0.2"),
+                 ("near(x, 1500)", "near(x, 1.5)"), ("near(x, 1000)", "near(x, 1.0)"), ("[1500, 0, 0]", "[1.5, 0, 0]")):
+        assert a in text
+        text = text.replace(a, b)
+    spec = build(parse(text))
     law = spec.model.layers[0].law
     assert law.f_c == pytest.approx(38e3) and law.f_ct == pytest.approx(C30.f_ct * 1e3)
     assert spec.model.layers[0].material.E1 == pytest.approx(law.E)
     r = spec.model.layers[0].reinforcement[0]
-    assert r.area == pytest.approx(np.pi * 25.0 / 200.0) and r.height == 30.0
+    assert r.area == pytest.approx(np.pi * 0.01 ** 2 / 4 / 0.2) and r.height == 0.03
 
 
 @pytest.mark.parametrize("edit, field, fix", [

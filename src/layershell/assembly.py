@@ -20,11 +20,6 @@ from .element.kernel import LayerBlock, layer_block, layer_response
 from .model import Model
 
 
-#: the largest IMPL-EX extrapolation ratio (next increment over the last): an increment grown
-#: more than this would extrapolate the damage rate of a short one far beyond where it held
-MAX_IMPLEX_RATIO = 4.0
-
-
 @dataclass(frozen=True)
 class Block:
     """One layer over the elements of one stack."""
@@ -384,137 +379,49 @@ class Assembler:
         self.blocks = build_blocks(model, dm)
         self.extra: list = []
         self._bulk: _LinearBulk | None = None
-        # inelastic layers (element/inelastic.py): the committed point states per block index, and
-        # the trial states of the last evaluation
-        from .element.inelastic import InelasticBlock, initial_state
+        # the point states of the inelastic layers (material_state.py)
+        from .material_state import MaterialStates
 
-        self.committed = {i: initial_state(b.ref) for i, b in enumerate(self.blocks) if isinstance(b.ref, InelasticBlock)}
-        self.trial = {i: st.copy() for i, st in self.committed.items()}
-        # IMPL-EX (element/inelastic.py): the state of the commit before and the histories
-        # extrapolated from the two; "implicit": the laws' plain update in every iteration
-        self.integration = getattr(model, "integration", "implex")
-        self.previous = {i: st.copy() for i, st in self.committed.items()}
-        self.extrapolated: dict = {}
-        # the pseudo-time of the last two commits (the solvers' load factor or increment count)
-        self.times = (0.0, 0.0)
-        self.ratio = 1.0
-        self._extrapolate()
-        if not model.point_states:  # (a second assembler of the same model, e.g. for probes, keeps the first's)
-            self._publish()
+        self.materials = MaterialStates(model, self.blocks)
         self._pattern()
 
     @property
     def inelastic(self) -> bool:
         """Some layer has a material history (its response depends on the committed state)."""
-        return bool(self.committed)
+        return self.materials.active
+
+    @property
+    def extrapolated(self) -> dict:
+        """The IMPL-EX layers' extrapolated histories (empty: none, or implicit integration)."""
+        return self.materials.extrapolated
 
     def commit(self, u_full: np.ndarray, time: float | None = None) -> None:
-        """Take the material state at ``u_full`` (a converged solution) as the committed one;
-        ``time``: its pseudo-time for the IMPL-EX extrapolation (default: one more than the last)."""
-        if not self.committed:
-            return
-        self._layers(u_full, np.zeros(self.dm.n_full), None)
-        self.previous = self.committed
-        self.committed = {i: st.copy() for i, st in self.trial.items()}
-        self.times = (self.times[1], self.times[1] + 1.0 if time is None else float(time))
-        self.ratio = 1.0
-        self._extrapolate()
-        self._publish()
+        """Take the material state at the converged ``u_full`` as committed (:class:`MaterialStates`)."""
+        if self.materials.active:
+            self._layers(u_full, np.zeros(self.dm.n_full), None)
+            self.materials.commit(time)
 
     def next_increment(self, time: float | None = None, ratio: float | None = None) -> None:
-        """The IMPL-EX extrapolation to pseudo-time ``time``, or by ``ratio`` (the next increment's
-        size over the last one's); neither: one unit."""
-        if not self.extrapolated:
-            return
-        t0, t1 = self.times
-        last = t1 - t0
-        if ratio is None:
-            ratio = 1.0 if time is None or last == 0.0 else (float(time) - t1) / last
-        ratio = min(max(ratio, 0.0), MAX_IMPLEX_RATIO)
-        if ratio != self.ratio:
-            self.ratio = ratio
-            self._extrapolate()
+        self.materials.next_increment(time, ratio)
 
     def implex_error(self, u_full: np.ndarray) -> float:
-        """The largest difference between the damage an IMPL-EX increment to ``u_full`` acted with
-        and the implicit update there (0 without extrapolated layers)."""
-        if not self.extrapolated:
+        """The IMPL-EX damage error of an increment to ``u_full`` (:meth:`MaterialStates.implex_error`)."""
+        if not self.materials.extrapolated:
             return 0.0
         self._layers(u_full, np.zeros(self.dm.n_full), None)
-        err = 0.0
-        for i, ex in self.extrapolated.items():
-            e = self.blocks[i].ref.law.implex_error(self.trial[i].bulk, ex.bulk)
-            err = max(err, float(e.max()) if e.size else 0.0)
-        return err
-
-    def _extrapolate(self) -> None:
-        from .element.inelastic import extrapolated_state
-
-        self.extrapolated = {}
-        if self.integration != "implex":
-            return
-        for i, st in self.committed.items():
-            ex = extrapolated_state(self.blocks[i].ref, self.previous[i], st, self.ratio)
-            if ex is not None:
-                self.extrapolated[i] = ex
-
-    def _publish(self) -> None:
-        """Hand the committed states to the model's outputs (``Model.point_states``)."""
-        states: dict = {}
-        for i, st in self.committed.items():
-            b = self.blocks[i]
-            states.setdefault(b.layer, []).append((b.elements, b.ref, st))
-        self.model.point_states.clear()
-        self.model.point_states.update(states)
+        return self.materials.implex_error()
 
     def material_dissipation(self) -> float:
-        """Energy the inelastic layers and their reinforcement have dissipated (committed state):
-        Σ dissipation per volume × dV over the points (sheets: × A_s dA)."""
-        total = 0.0
-        for i, st in self.committed.items():
-            ref = self.blocks[i].ref
-            if ref.law is not None:
-                total += float(ref.law.dissipation(st.bulk) @ ref.base.dV.ravel())
-            for s, ss in zip(ref.sheets, st.sheets):
-                total += float(s.law.dissipation(ss) @ s.w.ravel())
-        return total
+        return self.materials.dissipation()
 
     def material_events(self) -> dict[str, bool]:
-        """Which events the committed state has seen anywhere: ``cracking`` (concrete),
-        ``yielding`` (steel), ``rupture`` (reinforcement), from each law's ``events``."""
-        seen: dict[str, bool] = {}
-        for i, st in self.committed.items():
-            ref = self.blocks[i].ref
-            pairs = ([(ref.law, st.bulk)] if ref.law is not None else []) + list(zip((s.law for s in ref.sheets),
-                                                                                     st.sheets))
-            for law, state in pairs:
-                for name, flags in law.events(state).items():
-                    seen[name] = seen.get(name, False) or bool(np.any(flags))
-        return seen
+        return self.materials.events()
 
     def material_state(self) -> dict[str, np.ndarray]:
-        """The committed point states as plain arrays (snapshots, checkpoints)."""
-        out: dict[str, np.ndarray] = {}
-        for i, st in self.committed.items():
-            out.update(st.to_dict(f"block{i}"))
-            out.update(self.previous[i].to_dict(f"previous{i}"))
-        if out:
-            out["implex_times"] = np.array(self.times, float)
-        return out
+        return self.materials.arrays()
 
     def set_material_state(self, arrays: dict) -> None:
-        """Restore the committed point states from :meth:`material_state`'s arrays (KeyError if one
-        is missing or of another shape)."""
-        self.committed = {i: st.load(arrays, f"block{i}") for i, st in self.committed.items()}
-        self.previous = {i: st.load(arrays, f"previous{i}") for i, st in self.previous.items()}
-        if self.committed:
-            if "implex_times" not in arrays:
-                raise KeyError("implex_times")
-            self.times = tuple(float(t) for t in np.asarray(arrays["implex_times"]))
-            self.ratio = 1.0
-        self.trial = {i: st.copy() for i, st in self.committed.items()}
-        self._extrapolate()
-        self._publish()
+        self.materials.load(arrays)
 
     def add_blocks(self, extra: list) -> None:
         """Add element-like blocks with ``.dofs (e, m)`` and ``.response(u) -> (f, K)`` (contact)
@@ -582,7 +489,7 @@ class Assembler:
         the extra blocks (cohesive interfaces, contact) to it (re-forming the same element
         tangents would take most of an iteration of the DCB, ENF and lap-shear models); the
         internal forces still come from the kernel (:meth:`_layer_forces`)."""
-        if self.model.nonlinear or _jit() is None or not self.blocks or not self.extra or self.committed:
+        if self.model.nonlinear or _jit() is None or not self.blocks or not self.extra or self.materials.active:
             return None  # (without extra blocks Newton takes one or two iterations a step: no cache, no memory)
         if self._bulk is None:
             data = np.zeros(self.nnz)
@@ -616,12 +523,13 @@ class Assembler:
             U = u_full[b.dofs].reshape(b.dofs.shape[0], -1, 3)
             for s in range(0, b.dofs.shape[0], self.chunk):
                 sl = slice(s, s + self.chunk)
-                if bi in self.committed:
-                    from .element.inelastic import inelastic_response, put_trial
+                if bi in self.materials.committed:
+                    from .element.inelastic import inelastic_response
 
+                    mat = self.materials
                     fe, Ke, tr = inelastic_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl,
-                                                    self.committed[bi], self.extrapolated.get(bi))
-                    put_trial(self.trial[bi], b.ref, sl, tr)
+                                                    mat.committed[bi], mat.extrapolated.get(bi))
+                    mat.put(bi, sl, tr)
                 else:
                     fe, Ke = layer_response(b.ref, U[sl], self.model.nonlinear, data is not None, sl)
                 if f is not None:
@@ -743,4 +651,4 @@ class Assembler:
         geometric term), extra blocks declare it (``symmetric = True``, or ``symmetric_now`` for
         the tangent they gave last)."""
         return (all(getattr(b, "symmetric", False) or getattr(b, "symmetric_now", False) for b in self.extra)
-                and all(self.blocks[i].ref.symmetric for i in self.committed))
+                and all(self.blocks[i].ref.symmetric for i in self.materials.committed))
