@@ -985,119 +985,24 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                                probe_scales(st.scales, probes), floors(att.u) if floors is not None else None)
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
-        its = max(att.iterations, 1)
-        used = abs(dlam) if st.mode == "load" else st.size  # the size of this increment
-        history = st.recent if st.recent_mode == st.mode else []  # the last ones under this constraint
-        fac = min(2.0, max(0.5, ps.target_iterations / its))
-        if cuts:
-            fac = min(fac, 1.0)  # no growth right after a cut
-        elif (st.mode == "dissipation" and friction and used < DISSIPATION_INSENSITIVE_BELOW * st.dissipation_max
-              and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
-            # as below, where friction acts: each commit moves the friction's anchors and limits,
-            # and the count no longer falls with the size (without this the lap shear with alpha_T = 1e5
-            # holds Δτ at 0.2-0.7, 1/100 of its largest, by 8 iterations each: 703 instead of 142 increments)
-            fac = max(fac, INSENSITIVE_GROWTH)
-        elif (st.mode in ("load", "arc")
-              # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
-              # increments at any size (the slab on 16 × 12 takes 6-10 iterations at Δλ = 0.4-5
-              # kN/m², and the plain rule would shrink them from 5 to 0.4)
-              and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
-                   or (arc and st.mode == "load"))
-              and size_insensitive(used, its, history, ps.target_iterations)):
-            fac = max(fac, INSENSITIVE_GROWTH)
-        if st.mode in ("load", "arc"):
-            st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
-            st.recent_mode = st.mode
-        elif friction:
-            st.recent_dissipation = (st.recent_dissipation + [(used, its)])[-ARC_WINDOW:]
-            st.dissipation_max = max(st.dissipation_max, used)
-        if e_rel > 0.5:
-            fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
-        if st.mode == "load":
-            st.size = min(max(st.size * fac, inc_min), inc_max)
-        elif st.mode == "arc":
-            st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
-            elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
-            floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
-            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
-                st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
-        else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
-            # down where this one was longer (else a short bond's peak lies inside one increment)
-            dun = increment_length(problem, du)
-            st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
-            st.arc_length = max(min(dun, dl_max), dl_min)
-            if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
-                # nothing left to dissipate (the interface has separated, the reaction vanished):
-                # the prescribed displacement goes on elastically, by the arc length
-                st.mode, st.size = "arc", st.arc_length
+        _next_size(problem, st, ps, att, abs(dlam) if st.mode == "load" else st.size, cuts, e_rel, dG, du, conj,
+                   friction, displacement_path, (inc_min, inc_max, dl_min, dl_max))
         st.du_prev = du
         st.changed = resolves > 0  # the next direction by the work criterion
-        if st.rescue:  # the load-controlled increment passed the crawl: a stretch of them goes on
-            warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
-                         f"crawled or found no equilibrium); one load-controlled increment passed it to "
-                         f"{att.lam:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
-                         "had no solution); load-controlled increments go on while they converge without a jump")
-            st.rescue, st.stretch_from, st.stretch_accepted = "", lam, 1
-        elif arc and st.mode == "load":
-            if not st.stretch_accepted:
-                st.stretch_from = lam
-            st.stretch_accepted += 1
-            if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
-                # to it otherwise: the slab on 16 × 12 would go 323.5, 324.9, 325.29, 325.44, 325.456,
-                # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
-                which = "one load-controlled increment" if st.stretch_accepted == 1 else "load-controlled increments"
-                warns.append(f"step {n}: {which} took the path from load factor {st.stretch_from:.6g} to {att.lam:.6g}, "
-                             f"on a rising branch where the arc length's increments needed cuts; from there the "
-                             f"arc length again (this increment needed {cuts} halving(s))")
-                st.stretch_block, st.stretch_accepted = att.lam + abs(att.lam - lam), 0
-                st.mode, st.size, st.changed = "arc", st.arc_length, True
-            elif st.stretch_accepted == 1:
-                warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
-                             f"increments needed cuts, load-controlled increments go on while they converge "
-                             f"without a jump (to {att.lam:.6g} in this one)")
+        _stretch_bookkeeping(st, n, lam, att.lam, cuts, arc, warns)
         u, lam = att.u, att.lam
         st.reaction = conj[1] if conj is not None else math.nan
         peak_before, st.lam_peak = st.lam_peak, max(st.lam_peak, abs(lam))
         if (st.mode in ("arc", "dissipation") and stretch_may_start(ps, arc, displacement_path, cuts, lam, dlam,
                                                                      peak_before, st.stretch_block)):
             st.mode, st.size, st.stretch_accepted = "load", _rescue_increment(ps, lam), 0
-        grew = dD is not None and not displacement_path and beyond_round_off(dD, damage)
-        if grew:
-            st.lam_damaged = lam  # on the debonding branch (a stretch's load-controlled increments too)
-        if st.mode == "load":
-            st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
-        else:
-            st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
-                           or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
-                                               st.dissipated, ps.end_fraction))
-            if (dD is not None and not displacement_path and not grew and not st.finished
-                    and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak)):
-                raise ConvergenceError(
-                    f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
-                    f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
-                    f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
-                    f"the branch on which the interfaces debond - past a snap-back its constrained "
-                    f"iterations found no state with damage growth. The states up to here are kept; the "
-                    f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
-                    f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
-                    f"load and reports the energy it releases; or refine the mesh along the debonding front",
-                    lam, residuals[-1] if residuals else float("nan"))
-        st.recent_lams = (st.recent_lams + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
-        st.recent_dG = (st.recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
-        recent, recent_dG = st.recent_lams, st.recent_dG
-        crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
-                 and crawling(recent, recent_dG, ps.stall_increments, st.lam_peak, st.dissipated, ps.end_fraction))
-        if (not st.finished and st.mode != "load"
-                and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
-            st.finished = True
-            warns.append(f"step {n}: the load factor stayed within {max(recent) - min(recent):.3g} of "
-                         f"{lam:.4g} ({100 * abs(lam) / st.lam_peak:.2g} % of its peak {st.lam_peak:.4g}) over the "
-                         f"last {len(recent)} increments: the path ends as complete failure")
-        end_reason = None
-        if st.finished:
-            end_reason = End.LAMBDA_END if lam >= end - 1e-12 * max(1.0, abs(end)) else End.COMPLETE_FAILURE
-        elif n == ps.max_steps:
-            st.finished, end_reason = True, End.MAX_STEPS
+        end_reason, crawl = _path_end(problem, st, ps, n, lam, dlam, du, dG, dD, damage, to_end, displacement_path,
+                                      residuals, warns)
+        if crawl and _may_rescue(ps, arc, lam):
+            # one load-controlled increment next (Newton with its own active-set loop, which passes states
+            # where the constrained iterations on frozen sets have no solution), as long as λ rises
+            st.rescue, st.mode, st.size = crawl, "load", _rescue_increment(ps, lam)
+            st.recent_lams, st.recent_dG = [], []
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
                          start_inertia(problem))
@@ -1108,20 +1013,152 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         yield res
         if st.finished:
             return
-        if crawl:  # after the step is kept: the path cannot go on from it by the arc length
-            stop = (f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
-                    f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
-                    f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
-                    f"dissipated so far; the constrained iterations fail at every larger increment. The last converged "
-                    f"state is kept. Where the path is expected to rise to the design load, load control "
-                    f"(control = 'load') with [steps] stabilize passes such a state; else refine the mesh at the "
-                    f"debonding front")
-            if not _may_rescue(ps, arc, lam):
-                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
-            # one load-controlled increment (Newton with its own active-set loop, which passes states
-            # where the constrained iterations on frozen sets have no solution), as long as λ rises
-            st.rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)
-            st.recent_lams, st.recent_dG = [], []
+        if crawl and not st.rescue:  # after the step is kept: the path cannot go on from it
+            raise ConvergenceError(crawl, lam, residuals[-1] if residuals else float("nan"))
+
+
+def _next_size(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, used: float, cuts: int,
+               e_rel: float, dG: float, du: np.ndarray, conj: tuple[float, float] | None, friction: bool,
+               displacement_path: bool, bounds: tuple[float, float, float, float]) -> None:
+    """The constraint and size of the next increment after an accepted one of size ``used`` (Δλ,
+    Δl or Δτ) in ``att.iterations`` Newton iterations and ``cuts`` halvings: grow after easy
+    increments, shrink after hard ones (Crisfield 1981), aim below the energy tolerance
+    (``e_rel``), switch to the dissipation constraint where the increment dissipated (Verhoosel et
+    al. 2009) and back to the arc length where nothing is left to dissipate. ``bounds``: the
+    smallest and largest Δλ and Δl."""
+    inc_min, inc_max, dl_min, dl_max = bounds
+    arc = ps.control == "arc_length"
+    its = max(att.iterations, 1)
+    history = st.recent if st.recent_mode == st.mode else []  # the last ones under this constraint
+    fac = min(2.0, max(0.5, ps.target_iterations / its))
+    if cuts:
+        fac = min(fac, 1.0)  # no growth right after a cut
+    elif (st.mode == "dissipation" and friction and used < DISSIPATION_INSENSITIVE_BELOW * st.dissipation_max
+          and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
+        # as below, where friction acts: each commit moves the friction's anchors and limits,
+        # and the count no longer falls with the size (without this the lap shear with alpha_T = 1e5
+        # holds Δτ at 0.2-0.7, 1/100 of its largest, by 8 iterations each: 703 instead of 142 increments)
+        fac = max(fac, INSENSITIVE_GROWTH)
+    elif (st.mode in ("load", "arc")
+          # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
+          # increments at any size (the slab on 16 × 12 takes 6-10 iterations at Δλ = 0.4-5
+          # kN/m², and the plain rule would shrink them from 5 to 0.4)
+          and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
+               or (arc and st.mode == "load"))
+          and size_insensitive(used, its, history, ps.target_iterations)):
+        fac = max(fac, INSENSITIVE_GROWTH)
+    if st.mode in ("load", "arc"):
+        st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
+        st.recent_mode = st.mode
+    elif friction:
+        st.recent_dissipation = (st.recent_dissipation + [(used, its)])[-ARC_WINDOW:]
+        st.dissipation_max = max(st.dissipation_max, used)
+    if e_rel > 0.5:
+        fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
+    if st.mode == "load":
+        st.size = min(max(st.size * fac, inc_min), inc_max)
+    elif st.mode == "arc":
+        st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
+        elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
+        floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
+        if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
+            st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
+    else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
+        # down where this one was longer (else a short bond's peak lies inside one increment)
+        dun = increment_length(problem, du)
+        st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
+        st.arc_length = max(min(dun, dl_max), dl_min)
+        if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
+            # nothing left to dissipate (the interface has separated, the reaction vanished):
+            # the prescribed displacement goes on elastically, by the arc length
+            st.mode, st.size = "arc", st.arc_length
+
+
+def _stretch_bookkeeping(st: PathState, n: int, lam: float, lam_new: float, cuts: int, arc: bool,
+                         warns: list[str]) -> None:
+    """After increment ``n`` from ``lam`` to ``lam_new``: a load-controlled rescue that passed
+    starts a stretch of load-controlled increments under arc-length control; a stretch counts
+    its increments and ends (the arc length again) at one that needed a cut. Warnings to ``warns``."""
+    if st.rescue:  # the load-controlled increment passed the crawl: a stretch of them goes on
+        warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
+                     f"crawled or found no equilibrium); one load-controlled increment passed it to "
+                     f"{lam_new:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
+                     "had no solution); load-controlled increments go on while they converge without a jump")
+        st.rescue, st.stretch_from, st.stretch_accepted = "", lam, 1
+    elif arc and st.mode == "load":
+        if not st.stretch_accepted:
+            st.stretch_from = lam
+        st.stretch_accepted += 1
+        if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
+            # to it otherwise: the slab on 16 × 12 would go 323.5, 324.9, 325.29, 325.44, 325.456,
+            # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
+            which = "one load-controlled increment" if st.stretch_accepted == 1 else "load-controlled increments"
+            warns.append(f"step {n}: {which} took the path from load factor {st.stretch_from:.6g} to {lam_new:.6g}, "
+                         f"on a rising branch where the arc length's increments needed cuts; from there the "
+                         f"arc length again (this increment needed {cuts} halving(s))")
+            st.stretch_block, st.stretch_accepted = lam_new + abs(lam_new - lam), 0
+            st.mode, st.size, st.changed = "arc", st.arc_length, True
+        elif st.stretch_accepted == 1:
+            warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
+                         f"increments needed cuts, load-controlled increments go on while they converge "
+                         f"without a jump (to {lam_new:.6g} in this one)")
+
+
+def _path_end(problem: Problem, st: PathState, ps: PathSettings, n: int, lam: float, dlam: float, du: np.ndarray,
+              dG: float, dD: float | None, damage: float | None, to_end: bool, displacement_path: bool,
+              residuals: list[float], warns: list[str]) -> tuple[End | None, str]:
+    """After increment ``n`` (to ``lam``, by ``dlam`` and ``du``, dissipating ``dG``; ``dD``: the
+    damage the interfaces' ledger booked in it, of ``damage`` so far): whether the path ends here
+    (``st.finished`` and the End, else None), and the stop message where its increments crawl
+    ("" otherwise). ConvergenceError where a force path unloads without damage."""
+    end = ps.lambda_end
+    grew = dD is not None and not displacement_path and beyond_round_off(dD, damage)
+    if grew:
+        st.lam_damaged = lam  # on the debonding branch (a stretch's load-controlled increments too)
+    if st.mode == "load":
+        st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
+    else:
+        st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
+                       or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
+                                           st.dissipated, ps.end_fraction))
+        if (dD is not None and not displacement_path and not grew and not st.finished
+                and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak)):
+            raise ConvergenceError(
+                f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
+                f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
+                f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
+                f"the branch on which the interfaces debond - past a snap-back its constrained "
+                f"iterations found no state with damage growth. The states up to here are kept; the "
+                f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
+                f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
+                f"load and reports the energy it releases; or refine the mesh along the debonding front",
+                lam, residuals[-1] if residuals else float("nan"))
+    st.recent_lams = (st.recent_lams + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+    st.recent_dG = (st.recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+    recent, recent_dG = st.recent_lams, st.recent_dG
+    crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
+             and crawling(recent, recent_dG, ps.stall_increments, st.lam_peak, st.dissipated, ps.end_fraction))
+    if (not st.finished and st.mode != "load"
+            and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
+        st.finished = True
+        warns.append(f"step {n}: the load factor stayed within {max(recent) - min(recent):.3g} of "
+                     f"{lam:.4g} ({100 * abs(lam) / st.lam_peak:.2g} % of its peak {st.lam_peak:.4g}) over the "
+                     f"last {len(recent)} increments: the path ends as complete failure")
+    end_reason = None
+    if st.finished:
+        end_reason = End.LAMBDA_END if lam >= end - 1e-12 * max(1.0, abs(end)) else End.COMPLETE_FAILURE
+    elif n == ps.max_steps:
+        st.finished, end_reason = True, End.MAX_STEPS
+    if not crawl:
+        return end_reason, ""
+    return end_reason, (
+        f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
+        f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
+        f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
+        f"dissipated so far; the constrained iterations fail at every larger increment. The last converged "
+        f"state is kept. Where the path is expected to rise to the design load, load control "
+        f"(control = 'load') with [steps] stabilize passes such a state; else refine the mesh at the "
+        f"debonding front")
 
 
 def increment_length(problem: Problem, du: np.ndarray) -> float:
