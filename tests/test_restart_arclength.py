@@ -6,9 +6,9 @@ probes, Newton iterations and cuts for every later increment (to 1e-9 relative; 
 forgets part of the path's state - the last increments' sizes and iteration counts, a running
 stretch of load-controlled increments, the probes' scales - takes other increments, which changes
 the load factors by far more). The stop points are picked from the uninterrupted run itself: the
-increment of the first cut, the first under the dissipation constraint and the one before it, and
-the first of a stretch of load-controlled increments under arc-length control (where the example
-has one).
+increment of the first cut, the first under the dissipation constraint and the one before it, the
+first of a stretch of load-controlled increments under arc-length control and every one that ended
+such a stretch (where the example has them).
 """
 from __future__ import annotations
 
@@ -47,9 +47,10 @@ def _stop_points(full) -> dict[str, int]:
     stretch = next((k for k in sorted(modes) if modes[k] == "load"), None)
     if stretch is not None and stretch < n:
         points["in a load-controlled stretch"] = stretch
-    ended = next((k for k in sorted(modes) if k > 1 and modes[k - 1] == "load" and modes[k] != "load"), None)
-    if ended is not None and ended < n:
-        points["where a load-controlled stretch ended"] = ended
+    # every increment that ended a stretch (the next may start only past the load it reached)
+    ended = [k for k in sorted(modes) if k > 1 and modes[k - 1] == "load" and modes[k] != "load" and k < n]
+    for i, k in enumerate(ended):
+        points[f"where load-controlled stretch {i + 1} ended"] = k
     return points
 
 

@@ -801,41 +801,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         break
                     if friction:
                         fric_c1 = friction_excess(problem, att.u)[0]
-            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
-                    and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
-                ok, why, msg = False, Reason.TURNED_BACK, Reason.TURNED_BACK.message  # cut; accepted after 3 cuts
-            if (ok and st.mode == "arc" and not displacement_path and lam == st.lam_damaged
-                    and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
-                # from a state whose increment damaged, the arc length found the elastic unloading
-                # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
-                # elements, its crack past the load point, would go from λ = 0.6078 down so,
-                # 'unloads without damage'): the dissipation constraint next, which demands damage
-                ok, why, msg = False, Reason.ELASTIC_UNLOADING, Reason.ELASTIC_UNLOADING.message
-            if ok and ledger0 is not None and st.mode == "dissipation":
-                # the constraint takes the stored energy to be the secant one; where the structure
-                # unloads stiffer than the secant (crack faces closing, contact, friction) an
-                # elastic path meets it without damage - the prescribed opening of the DCB on 100
-                # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
-                # own ledger must book the dissipation. On displacement paths all of it counts; on
-                # force paths only damage, and only where the load falls (friction's work on
-                # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
-                # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
-                # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
-                # (Counting rising force increments too would refuse the lap shear with friction's
-                # unloading past its peak, which `unloading` below stops with a clearer message.)
-                # A refused increment is cut, then tried by the arc length, then by a rescue
-                if displacement_path:
-                    if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
-                        ok, why, msg = False, Reason.CLOSURE_REFUSED, Reason.CLOSURE_REFUSED.message
-                elif (att.lam < lam and problem.interfaces.cohesive()
-                      and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
-                    ok, why, msg = False, Reason.FRICTION_REFUSED, Reason.FRICTION_REFUSED.message
-            if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
-                # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
-                # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
-                # through closure meets the constraint without any damage (the force-loaded DCB
-                # on 150 elements would 'converge' from λ = 0.42 to -0.03 with its arms shut)
-                ok, why, msg = False, Reason.CROSSED_ZERO, Reason.CROSSED_ZERO.message
+            refused = (_constraint_refusal(problem, st, att, u, lam, to_end, cuts, ledger0, displacement_path)
+                       if ok else None)
+            if refused is not None:  # it meets its constraint for the wrong reason
+                ok, why, msg = False, refused, refused.message
             if (ok and arc and st.mode == "load" and not allow_jump and measure is not None and ps.jump_area is not None
                     and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
                 # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
@@ -1015,6 +984,49 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             return
         if crawl and not st.rescue:  # after the step is kept: the path cannot go on from it
             raise ConvergenceError(crawl, lam, residuals[-1] if residuals else float("nan"))
+
+
+def _constraint_refusal(problem: Problem, st: PathState, att: Attempt, u: np.ndarray, lam: float, to_end: bool,
+                        cuts: int, ledger0: tuple[float, float] | None, displacement_path: bool) -> Reason | None:
+    """Why the converged increment ``att`` from (``u``, ``lam``) is refused although it meets its
+    constraint (it turned back, unloads elastically from a debonding state, or met the dissipation
+    constraint without damage), else None. ``ledger0``: the interfaces' ledger at its start."""
+    if (st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
+            and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
+        return Reason.TURNED_BACK  # cut; accepted after 3 cuts
+    if (st.mode == "arc" and not displacement_path and lam == st.lam_damaged
+            and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
+        # from a state whose increment damaged, the arc length found the elastic unloading
+        # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
+        # elements, its crack past the load point, would go from λ = 0.6078 down so,
+        # 'unloads without damage'): the dissipation constraint next, which demands damage
+        return Reason.ELASTIC_UNLOADING
+    if ledger0 is not None and st.mode == "dissipation":
+        # the constraint takes the stored energy to be the secant one; where the structure
+        # unloads stiffer than the secant (crack faces closing, contact, friction) an
+        # elastic path meets it without damage - the prescribed opening of the DCB on 100
+        # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
+        # own ledger must book the dissipation. On displacement paths all of it counts; on
+        # force paths only damage, and only where the load falls (friction's work on
+        # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
+        # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
+        # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
+        # (Counting rising force increments too would refuse the lap shear with friction's
+        # unloading past its peak, which `unloading` below stops with a clearer message.)
+        # A refused increment is cut, then tried by the arc length, then by a rescue
+        if displacement_path:
+            if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
+                return Reason.CLOSURE_REFUSED
+        elif (att.lam < lam and problem.interfaces.cohesive()
+              and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
+            return Reason.FRICTION_REFUSED
+    if st.mode == "dissipation" and lam * att.lam < 0.0:
+        # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
+        # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
+        # through closure meets the constraint without any damage (the force-loaded DCB
+        # on 150 elements would 'converge' from λ = 0.42 to -0.03 with its arms shut)
+        return Reason.CROSSED_ZERO
+    return None
 
 
 def _next_size(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, used: float, cuts: int,
