@@ -1164,3 +1164,38 @@ def test_the_arc_length_goes_back_to_an_increment_from_a_length_it_can_cut(monke
     assert [s.load_factor for s in steps] == pytest.approx([0.51])
     assert [m for m, _ in tried] == ["arc"] + ["dissipation"] * 4 + ["arc"]
     assert tried[-1][1] == pytest.approx(al.ARC_AFTER_DISSIPATION / 2)  # taken back, cut once
+
+
+def test_a_restart_from_any_increments_state_continues_a_crawl_and_its_rescue(monkeypatch):
+    """path_steps restarted from the PathState of any increment (through its checkpoint arrays)
+    takes the uninterrupted run's increments, here through a crawl, the load-controlled rescue
+    it triggers and the stretch after it (a restart once forgot the crawl's λ history, the rescue
+    decided after the step was kept and the stretch's bookkeeping). Stand-ins: arc-length
+    increments of Δλ = 0.3 up to λ = 0.5 and of 10⁻⁹ beyond (the crawl; each dissipates its Δλ),
+    a Newton solve that converges at every λ."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonResult, NewtonSettings
+    from layershell.solver.path_state import PathState
+
+    def creeping(problem, u, lam, size, *a, **k):
+        dlam = 0.3 if lam < 0.5 else 1e-9
+        return al.Attempt(True, u + dlam, lam + dlam, 2, [1e-10])
+
+    def newton_anywhere(problem, u, lam, s):
+        return np.full(2, lam), NewtonResult(True, 2, [1e-10])
+
+    _path_stand_ins(monkeypatch, al, arc_attempt=creeping, newton=newton_anywhere,
+                    dissipation_increment=lambda problem, u, lam, du, dlam, *a: abs(dlam),
+                    full_weights=lambda problem: np.ones(2))
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.125, arc_length=1.0, stall_increments=3,
+                         jump_area=None, jump_ratio=None, dissipation=False)
+    full = [(r.step, r.load_factor, r.u, r.state) for r in al.path_steps(_stand_in_problem(), NewtonSettings(), ps,
+                                                                           u0=np.zeros(2))]
+    lams = [lam for _, lam, _, _ in full]
+    modes = [st.mode for _, _, _, st in full]
+    assert "load" in modes and lams[-1] == pytest.approx(1.0)  # the rescue and its stretch reach λ_end
+    assert 3 <= modes.index("load") < len(full) - 1
+    for step, lam, u, st in full[:-1]:
+        again = [r.load_factor for r in al.path_steps(_stand_in_problem(), NewtonSettings(), ps, u0=u, lam0=lam,
+                                                      step0=step, state=PathState.from_arrays(st.to_arrays()))]
+        assert again == pytest.approx(lams[step:], rel=1e-12), step
