@@ -34,7 +34,8 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
+from enum import Enum
 from typing import Callable, Iterator
 
 import numpy as np
@@ -735,41 +736,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                    if on_step_end is not None and hasattr(problem.interfaces, "dissipation") else None)
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
-            to_end = False
-            # IMPL-EX: the damage rate of the last accepted increment scaled to this one's size
-            next_increment(problem, ratio=(st.size / st.implex_size if st.implex_mode == st.mode
-                                           and st.implex_size > 0 else 1.0))
+            att, to_end = _try_increment(problem, st, s, ps, u, lam, cuts, f_itf0)
             e_rel = 0.0
-            if st.mode == "load":
-                dlam = min(st.size, end - lam)
-                to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
-                trial = end if to_end else lam + dlam
-                u_new, res = implex_checked(problem, newton(problem, u, trial, s), cuts)
-                att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
-            else:
-                att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
-                                  max(st.lam_peak, abs(lam)), f_itf0)
-                if att.converged:
-                    _, chk = implex_checked(problem, (att.u, NewtonResult(True, att.iterations, att.residuals)), cuts)
-                    if not chk.converged:
-                        att = Attempt(False, att.u, att.lam, att.iterations, att.residuals, chk.message)  # (IMPL-EX)
-                if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
-                    u_new, res = newton(problem, u, end, s)
-                    if res.converged:
-                        att = Attempt(True, u_new, end, att.iterations + res.iterations,
-                                      att.residuals + res.residuals)
-                        to_end = True
-                    elif st.end_cuts < END_CUTS:
-                        st.end_cuts += 1
-                        # load control has no equilibrium at λ_end from here: the increment passed a
-                        # snap-back on its way beyond λ_end (the MITC9 plate on 12 × 12: from 0.982
-                        # through the flap's debonding to 1.0245 in one increment). Shorter ones end
-                        # past the snap-back and below λ_end, from where λ_end is reached
-                        att = Attempt(False, att.u, att.lam, att.iterations + res.iterations,
-                                      att.residuals + res.residuals,
-                                      f"the increment passes λ_end = {end:g} (to {att.lam:.6g}), where load "
-                                      f"control from {lam:.6g} finds no equilibrium ({res.message})",
-                                      reason=Reason.PASSES_END)
             total_it += att.iterations
             residuals += att.residuals
             ok, why, msg = att.converged, att.reason, att.message
@@ -805,16 +773,10 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                        if ok else None)
             if refused is not None:  # it meets its constraint for the wrong reason
                 ok, why, msg = False, refused, refused.message
-            if (ok and arc and st.mode == "load" and not allow_jump and measure is not None and ps.jump_area is not None
-                    and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
-                # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
-                # it passes (half of the slab's interface debonding at once, no re-solution to see
-                # it in) shows only in the converged increment's debonded area
-                ok, why, msg = False, Reason.DEBONDING_JUMP, Reason.DEBONDING_JUMP.message
-            if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
-                if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
-                                 st.scales, floors(att.u) if floors is not None else None):
-                    ok, why, msg = False, Reason.PROBE_JUMP, Reason.PROBE_JUMP.message
+            refused = (_jumped(problem, st, ps, att, n, lam, measure, area_prev, watch, probes_prev, floors)
+                       if ok and not allow_jump else None)
+            if refused is not None:
+                ok, why, msg = False, refused, refused.message
             if ok and b0 is not None and (st.mode != "load" or not st.rescue):
                 # (b0: arc-length control; its stretches of load-controlled increments too - the
                 # MMB's second rise to λ = 1, its crack still growing, takes increments too long for
@@ -897,41 +859,14 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     st.size = size0  # the jump is behind: the size before the cuts, halved below
                     break
             if limit:
-                if jump and st.rescue:  # a load-controlled rescue may not jump a snap-back
-                    raise ConvergenceError(
-                        st.rescue + f"; a load-controlled increment from it jumps ({msg} at every size down to "
-                        f"Δλ = {st.size:.3g}): the path snaps back there. Load control with [steps] unstable = "
-                        "'relax' passes the jump at a fixed load and reports the energy it releases",
-                        lam, residuals[-1] if residuals else float("nan"))
-                if jump:
-                    allow_jump = True  # cutting does not help: accept the jump, with a warning
-                    continue
-                if st.mode == "dissipation":  # once per increment: then the arc length alone
-                    # its direction by the work criterion, as after "no dissipation" above: past a
-                    # snap-back the previous direction follows elastic unloading down to λ = 0.
-                    # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
-                    st.mode, st.changed = "arc", True
-                    st.size = arc_length_restart(st.arc_length, st.arc_length0, dl_max)
-                    cuts, tried_dissipation = 0, True
-                    continue
-                if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
+                then = _at_the_limit(problem, st, s, ps, n, lam, u, step0, cuts, jump, msg, size0, residuals)
+                if then is _Then.END:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
-                if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
-                    cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
-                    continue
-                if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
-                    cuts, st.size = 0, size0  # as load_steps: the thesis's contact at the nodes from here on
-                    continue
-                if st.rescue:  # the load-controlled increment did not pass either
-                    raise ConvergenceError(st.rescue + f"; a load-controlled increment from it found no equilibrium "
-                                           f"either ({msg})", lam, residuals[-1] if residuals else float("nan"))
-                stop = (f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step cuts ({msg}); the "
-                        f"last converged load factor is {lam:.6g}"
-                        + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem))
-                if st.mode != "load" and _may_rescue(ps, arc, lam):
-                    st.rescue, st.mode, st.size, cuts = stop, "load", _rescue_increment(ps, lam), 0  # see the crawl below
-                    continue
-                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
+                if then is _Then.ACCEPT_JUMP:
+                    allow_jump = True  # cutting does not help: accept the jump, with a warning
+                else:
+                    cuts, tried_dissipation = 0, tried_dissipation or then is _Then.ARC
+                continue
             st.size *= 0.5
         # accepted increment
         commit_state(problem, att.u)
@@ -984,6 +919,121 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             return
         if crawl and not st.rescue:  # after the step is kept: the path cannot go on from it
             raise ConvergenceError(crawl, lam, residuals[-1] if residuals else float("nan"))
+
+
+class _Then(Enum):
+    """What follows an increment cut to its limit (:func:`_at_the_limit`)."""
+
+    ACCEPT_JUMP = 1  # cutting does not help: accept the jump, with a warning
+    ARC = 2  # the arc length alone from here, uncut
+    RETRY = 3  # the same increment again, uncut, in a changed setting (constraint, stabilisation, contact)
+    END = 4  # complete failure: the path ends
+
+
+def _at_the_limit(problem: Problem, st: PathState, s: NewtonSettings, ps: PathSettings, n: int, lam: float,
+                  u: np.ndarray, step0: int, cuts: int, jump: bool, msg: str, size0: float,
+                  residuals: list[float]) -> "_Then":
+    """An increment from (``u``, ``lam``) cut ``cuts`` times to its limit (``jump``: it jumped;
+    ``msg``: why its last try failed; ``size0``: its size before the cuts): what follows, or
+    ConvergenceError where nothing is left to try."""
+    arc = ps.control == "arc_length"
+    dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * st.arc_length0
+    if jump and st.rescue:  # a load-controlled rescue may not jump a snap-back
+        raise ConvergenceError(
+            st.rescue + f"; a load-controlled increment from it jumps ({msg} at every size down to "
+            f"Δλ = {st.size:.3g}): the path snaps back there. Load control with [steps] unstable = "
+            "'relax' passes the jump at a fixed load and reports the energy it releases",
+            lam, residuals[-1] if residuals else float("nan"))
+    if jump:
+        return _Then.ACCEPT_JUMP
+    if st.mode == "dissipation":  # once per increment: then the arc length alone
+        # its direction by the work criterion, as after "no dissipation" above: past a
+        # snap-back the previous direction follows elastic unloading down to λ = 0.
+        # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
+        st.mode, st.changed = "arc", True
+        st.size = arc_length_restart(st.arc_length, st.arc_length0, dl_max)
+        return _Then.ARC
+    if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
+        return _Then.END
+    if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
+        st.size = ps.increment  # as load_steps: viscous from the converged state on
+        return _Then.RETRY
+    if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
+        st.size = size0  # as load_steps: the thesis's contact at the nodes from here on
+        return _Then.RETRY
+    if st.rescue:  # the load-controlled increment did not pass either
+        raise ConvergenceError(st.rescue + f"; a load-controlled increment from it found no equilibrium "
+                               f"either ({msg})", lam, residuals[-1] if residuals else float("nan"))
+    stop = (f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step cuts ({msg}); the "
+            f"last converged load factor is {lam:.6g}"
+            + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem))
+    if st.mode != "load" and _may_rescue(ps, arc, lam):
+        st.rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)  # as after a crawl
+        return _Then.RETRY
+    raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
+
+
+def _try_increment(problem: Problem, st: PathState, s: NewtonSettings, ps: PathSettings, u: np.ndarray, lam: float,
+                   cuts: int, f_itf0: np.ndarray | None) -> tuple[Attempt, bool]:
+    """One try of the next increment from (``u``, ``lam``) under the constraint ``st.mode`` of
+    size ``st.size`` (``cuts``: its halvings so far): the Attempt, and whether it ends at λ_end
+    (an arc-length increment that passes λ_end is replaced by a load-controlled one to it)."""
+    end = ps.lambda_end
+    to_end = False
+    # IMPL-EX: the damage rate of the last accepted increment scaled to this one's size
+    next_increment(problem, ratio=(st.size / st.implex_size if st.implex_mode == st.mode
+                                   and st.implex_size > 0 else 1.0))
+    if st.mode == "load":
+        dlam = min(st.size, end - lam)
+        to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
+        trial = end if to_end else lam + dlam
+        u_new, res = implex_checked(problem, newton(problem, u, trial, s), cuts)
+        att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
+    else:
+        att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
+                          max(st.lam_peak, abs(lam)), f_itf0)
+        if att.converged:
+            _, chk = implex_checked(problem, (att.u, NewtonResult(True, att.iterations, att.residuals)), cuts)
+            if not chk.converged:
+                att = Attempt(False, att.u, att.lam, att.iterations, att.residuals, chk.message)  # (IMPL-EX)
+        if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
+            u_new, res = newton(problem, u, end, s)
+            if res.converged:
+                att = Attempt(True, u_new, end, att.iterations + res.iterations,
+                              att.residuals + res.residuals)
+                to_end = True
+            elif st.end_cuts < END_CUTS:
+                st.end_cuts += 1
+                # load control has no equilibrium at λ_end from here: the increment passed a
+                # snap-back on its way beyond λ_end (the MITC9 plate on 12 × 12: from 0.982
+                # through the flap's debonding to 1.0245 in one increment). Shorter ones end
+                # past the snap-back and below λ_end, from where λ_end is reached
+                att = Attempt(False, att.u, att.lam, att.iterations + res.iterations,
+                              att.residuals + res.residuals,
+                              f"the increment passes λ_end = {end:g} (to {att.lam:.6g}), where load "
+                              f"control from {lam:.6g} finds no equilibrium ({res.message})",
+                              reason=Reason.PASSES_END)
+    return att, to_end
+
+
+def _jumped(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, n: int, lam: float,
+            measure: Callable | None, area_prev: float | None, watch: Callable | None,
+            probes_prev: dict | None, floors: Callable | None) -> Reason | None:
+    """Whether the converged increment ``att`` (number ``n``, from ``lam``) jumps: a stretch's
+    load-controlled increment whose debonded area (``measure``) grew by more than ``jump_area``
+    since ``area_prev``, or a watched probe that grew more than ``jump_ratio`` times faster than λ
+    (:func:`jump_warnings`)."""
+    if (ps.control == "arc_length" and st.mode == "load" and measure is not None and ps.jump_area is not None
+            and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
+        # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
+        # it passes (half of the slab's interface debonding at once, no re-solution to see
+        # it in) shows only in the converged increment's debonded area
+        return Reason.DEBONDING_JUMP
+    if (watch is not None and ps.jump_ratio is not None
+            and jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
+                              st.scales, floors(att.u) if floors is not None else None)):
+        return Reason.PROBE_JUMP
+    return None
 
 
 def _constraint_refusal(problem: Problem, st: PathState, att: Attempt, u: np.ndarray, lam: float, to_end: bool,
