@@ -1036,30 +1036,51 @@ def test_an_increment_past_lambda_end_that_load_control_cannot_reach_is_cut(monk
 
 
 def test_the_path_state_survives_a_checkpoint_whole():
-    """Every field of arclength.PathState, set away from its default, comes back from the arrays
-    a checkpoint stores (the last load with damage growth and the arc length's recent increments
-    were the ones a restart could lose)."""
+    """Every field of PathState, set away from its default, comes back from the arrays a
+    checkpoint stores (a field that did not would be reset by a restart), also through an npz
+    file; a checkpoint without some of them (written by an earlier version) keeps their defaults."""
+    import io
+    import math
     from dataclasses import fields
 
-    from layershell.solver import arclength as al
+    from layershell.solver.path_state import PathState
 
-    st = al.PathState(mode="arc", size=2e-4, arc_length=3e-4, du_prev=np.arange(3.0), lam_peak=2.5,
-                      dissipated=0.7, finished=True, arc_length0=1e-2, changed=True,
-                      lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc",
-                      dissipation_max=0.3, recent_dissipation=[(1e-2, 8), (1.5e-2, 8)])
-    assert all(getattr(st, f.name) != getattr(al.PathState(), f.name) for f in fields(st)
-               if f.name != "du_prev")
-    back = al.PathState.from_arrays(st.arrays())
+    st = PathState(mode="arc", size=2e-4, arc_length=3e-4, du_prev=np.arange(3.0), lam_peak=2.5,
+                   dissipated=0.7, finished=True, arc_length0=1e-2, changed=True,
+                   lam_damaged=2.25, recent=[(1e-4, 7), (1.2e-4, 9)], recent_mode="arc",
+                   dissipation_max=0.3, recent_dissipation=[(1e-2, 8), (1.5e-2, 8)],
+                   recent_lams=[0.5, 0.51], recent_dG=[1e-3, 2e-3], scales={"P": 3.0, "w.top": 0.25},
+                   reaction=12.5, rescue="step 7: stuck", stretch_from=0.4, stretch_accepted=3,
+                   stretch_block=0.45, end_cuts=2, implex_mode="load", implex_size=0.05)
+    default = PathState()
+    assert all(not (getattr(st, f.name) == getattr(default, f.name)
+                    or (isinstance(getattr(default, f.name), float) and math.isnan(getattr(default, f.name))
+                        and math.isnan(getattr(st, f.name))))
+               for f in fields(st) if f.name != "du_prev")
+    buf = io.BytesIO()
+    np.savez(buf, **st.to_arrays())
+    buf.seek(0)
+    with np.load(buf, allow_pickle=False) as z:
+        back = PathState.from_arrays({k: z[k] for k in z.files})
     for f in fields(st):
         if f.name == "du_prev":
             np.testing.assert_array_equal(back.du_prev, st.du_prev)
         else:
             assert getattr(back, f.name) == getattr(st, f.name), f.name
+    # a copy does not share the lists, the dict or du_prev
+    c = st.copy()
+    c.recent.append((1.0, 1))
+    c.scales["P"] = 9.0
+    c.du_prev[0] = 5.0
+    assert len(st.recent) == 2 and st.scales["P"] == 3.0 and st.du_prev[0] == 0.0
     # a checkpoint written before `recent` kept the last load-controlled increment on its own
-    old = {k: v for k, v in st.arrays().items() if k not in ("path.recent", "path.recent_mode")}
+    old = {k: v for k, v in st.to_arrays().items()
+           if k not in ("path.recent", "path.recent_mode", "path.recent_lams", "path.scales", "path.rescue")}
     old.update({"path.last_increment": np.array(0.01), "path.last_iterations": np.array(6)})
-    back = al.PathState.from_arrays(old)
+    back = PathState.from_arrays(old)
     assert back.recent == [(0.01, 6)] and back.recent_mode == "load"
+    assert back.recent_lams == [] and back.scales == {} and back.rescue == ""
+    assert PathState.from_arrays({}) is None
 
 
 def _arc_from_a_length(monkeypatch, al, least: float, **patches):
@@ -1143,3 +1164,38 @@ def test_the_arc_length_goes_back_to_an_increment_from_a_length_it_can_cut(monke
     assert [s.load_factor for s in steps] == pytest.approx([0.51])
     assert [m for m, _ in tried] == ["arc"] + ["dissipation"] * 4 + ["arc"]
     assert tried[-1][1] == pytest.approx(al.ARC_AFTER_DISSIPATION / 2)  # taken back, cut once
+
+
+def test_a_restart_from_any_increments_state_continues_a_crawl_and_its_rescue(monkeypatch):
+    """path_steps restarted from the PathState of any increment (through its checkpoint arrays)
+    takes the uninterrupted run's increments, here through a crawl, the load-controlled rescue
+    it triggers and the stretch after it (a restart once forgot the crawl's λ history, the rescue
+    decided after the step was kept and the stretch's bookkeeping). Stand-ins: arc-length
+    increments of Δλ = 0.3 up to λ = 0.5 and of 10⁻⁹ beyond (the crawl; each dissipates its Δλ),
+    a Newton solve that converges at every λ."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonResult, NewtonSettings
+    from layershell.solver.path_state import PathState
+
+    def creeping(problem, u, lam, size, *a, **k):
+        dlam = 0.3 if lam < 0.5 else 1e-9
+        return al.Attempt(True, u + dlam, lam + dlam, 2, [1e-10])
+
+    def newton_anywhere(problem, u, lam, s):
+        return np.full(2, lam), NewtonResult(True, 2, [1e-10])
+
+    _path_stand_ins(monkeypatch, al, arc_attempt=creeping, newton=newton_anywhere,
+                    dissipation_increment=lambda problem, u, lam, du, dlam, *a: abs(dlam),
+                    full_weights=lambda problem: np.ones(2))
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.125, arc_length=1.0, stall_increments=3,
+                         jump_area=None, jump_ratio=None, dissipation=False)
+    full = [(r.step, r.load_factor, r.u, r.state) for r in al.path_steps(_stand_in_problem(), NewtonSettings(), ps,
+                                                                           u0=np.zeros(2))]
+    lams = [lam for _, lam, _, _ in full]
+    modes = [st.mode for _, _, _, st in full]
+    assert "load" in modes and lams[-1] == pytest.approx(1.0)  # the rescue and its stretch reach λ_end
+    assert 3 <= modes.index("load") < len(full) - 1
+    for step, lam, u, st in full[:-1]:
+        again = [r.load_factor for r in al.path_steps(_stand_in_problem(), NewtonSettings(), ps, u0=u, lam0=lam,
+                                                      step0=step, state=PathState.from_arrays(st.to_arrays()))]
+        assert again == pytest.approx(lams[step:], rel=1e-12), step

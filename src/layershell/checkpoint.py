@@ -16,7 +16,9 @@ NumPy arrays only (read with ``allow_pickle=False``):
   the probes.csv rows and the ParaView series there, and the steps in ``summary``; they are
   still read);
 * ``extra/...``: the debonded flags of the steps the zone maps may show (bounded, see
-  :class:`~layershell.plots.ZoneHistory`).
+  :class:`~layershell.plots.ZoneHistory`) and, for path following, ``extra/path.*``: the whole
+  :class:`~layershell.solver.path_state.PathState` (constraint, sizes, recent increments,
+  stretches, rescue), so that a restarted run takes the same increments as an uninterrupted one.
 
 A checkpoint holding NaN or infinite displacements is refused (:func:`load`).
 

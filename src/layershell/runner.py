@@ -17,6 +17,7 @@ from .io.build import RunSpec
 from .recorder import Recorder, read_history
 from .solver.arclength import ENERGY_WARN, probe_scales
 from .solver.newton import ConvergenceError, DebondCut, load_steps, start_inertia
+from .solver.path_state import End
 from .solver.problem import Problem
 from .threads import openblas_single_thread
 
@@ -165,8 +166,9 @@ def _restore_zones(zones, extra: dict[str, np.ndarray]) -> None:
 def _path_steps(spec: RunSpec, problem: Problem, u, lam0: float, step0: int, ck, on_step_end,
                 floors: "_ProbeFloors"):
     """The converged increments of arc-length or adaptive load control, continued from the
-    checkpoint's path state (arc length, constraint, last increment) after a restart."""
-    from .solver.arclength import PathState, path_steps
+    checkpoint's path state (:class:`~layershell.solver.path_state.PathState`, whole) after a restart."""
+    from .solver.arclength import path_steps
+    from .solver.path_state import PathState
 
     ctl = problem.interfaces
     state = PathState.from_arrays(ck.extra) if ck is not None else None
@@ -360,7 +362,7 @@ def _stabilized(summary: dict, where: dict, energy: dict | None, step: int, log)
 
 def _path_arrays(st) -> dict[str, np.ndarray]:
     state = getattr(st, "state", None)
-    return state.arrays() if state is not None else {}
+    return state.to_arrays() if state is not None else {}
 
 
 class _JumpWatch:
@@ -770,8 +772,8 @@ def _run(spec: RunSpec, rcd: Recorder | None, progress, write_vtu, restart, ck, 
                     rec["path"] = {"constraint": st.state.mode, "size": float(st.state.size),
                                    "dissipation": float(st.dissipation)}
                     if getattr(st, "end", None):
-                        summary["path_end"] = st.end  # lambda_end, complete failure or max_steps
-                        if st.end == "max_steps":
+                        summary["path_end"] = st.end.value  # lambda_end, complete failure or max_steps
+                        if st.end is End.MAX_STEPS:
                             _ended_early(summary, st, spec.path_following, log)
                 jumps.check(st, vals, rec.get("debonded_area"), ctl)
                 energy = ctl.energies(problem, u) if energy_names else None

@@ -34,7 +34,8 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
+from enum import Enum
 from typing import Callable, Iterator
 
 import numpy as np
@@ -45,6 +46,7 @@ from .newton import (FRICTION_STAGNATION, MAX_REFREEZE, RELAX_AFTER_CUTS, Active
                      check_stabilised_step, cohesive_hint, contact_hint, contact_to_nodes, dissipation_so_far, early_blocks, early_refreeze,
                      friction_acts, newton, reaction_scale, record_scale, relax, resolve, stabilise, stagnates,
                      implex_checked, next_increment, start_inertia)
+from .path_state import End, PathState, Reason
 from .problem import Problem, commit_state
 
 
@@ -94,70 +96,6 @@ class PathSettings:
 
 
 @dataclass
-class PathState:
-    """What continues a path after a restart (stored in checkpoint.npz as ``path.*``)."""
-
-    mode: str = ""  # "load" (under arc-length control: a stretch), "arc", "dissipation"; "" at first
-    size: float = 0.0  # Δλ, Δl or Δτ of the next increment
-    arc_length: float = 0.0  # the arc length (kept while the dissipation constraint acts)
-    du_prev: np.ndarray | None = None  # full-space increment of the last step (predictor sign)
-    lam_peak: float = 0.0  # largest |λ| so far
-    dissipated: float = 0.0  # Σ ΔG of the increments so far
-    finished: bool = False
-    arc_length0: float = 0.0  # the first arc length (sets the default bounds)
-    changed: bool = False  # the last increment changed the state (debonding): work criterion next
-    lam_damaged: float = math.nan  # λ of the last increment in which damage grew (force paths; unloading())
-    # (size, Newton iterations) of the last increments under the constraint ``recent_mode``
-    # ("load": Δλ, "arc": Δl): the last one under load control, ARC_WINDOW under arc-length
-    # control (size_insensitive)
-    recent: list = field(default_factory=list)
-    recent_mode: str = ""
-    # where friction acts on a damaged share: the largest dissipation-controlled increment Δτ so
-    # far and the last ARC_WINDOW (Δτ, iterations) under that constraint (size_insensitive)
-    dissipation_max: float = 0.0
-    recent_dissipation: list = field(default_factory=list)
-
-    def arrays(self) -> dict[str, np.ndarray]:
-        out = {"path.mode": np.array(self.mode), "path.size": np.array(self.size),
-               "path.arc_length": np.array(self.arc_length), "path.lam_peak": np.array(self.lam_peak),
-               "path.dissipated": np.array(self.dissipated), "path.finished": np.array(self.finished),
-               "path.arc_length0": np.array(self.arc_length0), "path.changed": np.array(self.changed),
-               "path.lam_damaged": np.array(self.lam_damaged),
-               "path.dissipation_max": np.array(self.dissipation_max),
-               "path.recent_dissipation": np.array(self.recent_dissipation, float).reshape(-1, 2)}
-        if self.du_prev is not None:
-            out["path.du_prev"] = self.du_prev.copy()
-        if self.recent:
-            out["path.recent"] = np.array(self.recent, float).reshape(-1, 2)
-            out["path.recent_mode"] = np.array(self.recent_mode)
-        return out
-
-    @classmethod
-    def from_arrays(cls, a: dict[str, np.ndarray]) -> "PathState | None":
-        if "path.mode" not in a:
-            return None
-        return cls(str(a["path.mode"]), float(a["path.size"]), float(a["path.arc_length"]),
-                   np.array(a["path.du_prev"], float) if "path.du_prev" in a else None,
-                   float(a["path.lam_peak"]), float(a["path.dissipated"]), bool(a["path.finished"]),
-                   float(a["path.arc_length0"]), bool(a["path.changed"]),
-                   float(a["path.lam_damaged"]) if "path.lam_damaged" in a else math.nan,
-                   *_recent_from_arrays(a), float(a.get("path.dissipation_max", 0.0)),
-                   [(float(x), int(n)) for x, n in np.asarray(a.get("path.recent_dissipation", np.zeros((0, 2)))
-                                                             ).reshape(-1, 2)])
-
-
-def _recent_from_arrays(a: dict[str, np.ndarray]) -> tuple[list, str]:
-    """PathState.recent and recent_mode from a checkpoint's arrays; checkpoints written before
-    them kept the last load-controlled increment as path.last_increment / last_iterations."""
-    if "path.recent" in a:
-        return ([(float(x), int(n)) for x, n in np.asarray(a["path.recent"]).reshape(-1, 2)],
-                str(a["path.recent_mode"]))
-    if float(a.get("path.last_increment", 0.0)) > 0.0:
-        return [(float(a["path.last_increment"]), int(a["path.last_iterations"]))], "load"
-    return [], ""
-
-
-@dataclass
 class Attempt:
     converged: bool
     u: np.ndarray
@@ -170,6 +108,7 @@ class Attempt:
     # the last constrained iterations ended early, near their solution, where the frozen sets no
     # longer held (EARLY_REFREEZE): not a converged state
     early: bool = False
+    reason: Reason = Reason.NOT_CONVERGED  # why it did not converge (the branches of path_steps decide by it)
 
 
 def check_path(problem: Problem, ps: PathSettings) -> None:
@@ -436,7 +375,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         if fric_c0 is not None:  # + Δc ≈ ∂c/∂u·Δu
             a1 += float(friction_excess(problem, u0, True)[1] @ dUt)
         if abs(a1 - a2) <= 1e-6 * (abs(a1) + abs(a2)):
-            att.message = "no dissipation in the predictor direction"
+            att.message, att.reason = Reason.NO_DISSIPATION.message, Reason.NO_DISSIPATION
             return _unfrozen(att, blocks)
         dlam = size / (a1 - a2)
     else:
@@ -451,7 +390,7 @@ def arc_attempt(problem: Problem, u0: np.ndarray, lam0: float, size: float, mode
         # dissipate, and the predictor would move λ by more than its largest value so far)
         if (abs(den) <= 1e-6 * 0.5 * sum(abs(x) for x in terms)
                 or (g is not None and abs(size) > lam_ref * abs(den))):
-            att.message = "no dissipation in the predictor direction"
+            att.message, att.reason = Reason.NO_DISSIPATION.message, Reason.NO_DISSIPATION
             return _unfrozen(att, blocks)
         dlam = size / den
     dur = dlam * dut
@@ -768,22 +707,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
     inc_min = ps.increment * 0.5 ** (ps.max_cuts + 8)
     area_prev = measure(problem) if measure is not None else None
     probes_prev = watch(u, lam) if watch is not None else None
-    scales = probe_scales({}, probes_prev)
+    st.scales = probe_scales(st.scales, probes_prev)
     end = ps.lambda_end
-    recent: list[float] = []  # λ of the last accepted increments (stalled(), crawling())
-    recent_dG: list[float] = []  # and their |ΔG| (crawling())
     itf_form = interface_form(problem)  # the dissipation measured at the interfaces
     # λ scales prescribed displacements: after complete separation the path goes on elastically
     # (no reaction) to λ_end, under the arc length again (below)
     displacement_path = arc and prescribed_direction(problem) is not None
-    reaction: float | None = None  # R = gᵀ f_int at the committed state (displacement paths; conjugates)
-    rescue: str | None = None  # a crawl's stop message while one load-controlled increment tries to pass it
-    # a stretch of load-controlled increments under arc-length control (st.mode "load"): where it
-    # began (its first accepted increment), how many it accepted, and the load factor below
-    # which no new one starts (where the last one ended without passing, see stretch_may_start)
-    stretch_from, stretch_accepted, stretch_block = lam, 0, -math.inf
-    end_cuts = 0  # increments cut since they passed λ_end where load control could not reach it (END_CUTS)
-    implex_last: tuple[str, float] | None = None  # (mode, size) of the last accepted increment (IMPL-EX)
     for n in range(step0 + 1, ps.max_steps + 1):
         t0 = time.perf_counter()
         problem.begin_step()  # its first solve, at u, keeps the inertia of its tangent (stability.py)
@@ -807,44 +736,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                    if on_step_end is not None and hasattr(problem.interfaces, "dissipation") else None)
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
-            to_end = False
-            # IMPL-EX: the damage rate of the last accepted increment scaled to this one's size
-            next_increment(problem, ratio=(st.size / implex_last[1] if implex_last is not None
-                                           and implex_last[0] == st.mode and implex_last[1] > 0 else 1.0))
+            att, to_end = _try_increment(problem, st, s, ps, u, lam, cuts, f_itf0)
             e_rel = 0.0
-            if st.mode == "load":
-                dlam = min(st.size, end - lam)
-                to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
-                trial = end if to_end else lam + dlam
-                u_new, res = implex_checked(problem, newton(problem, u, trial, s), cuts)
-                att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
-            else:
-                att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
-                                  max(st.lam_peak, abs(lam)), f_itf0)
-                if att.converged:
-                    _, chk = implex_checked(problem, (att.u, NewtonResult(True, att.iterations, att.residuals)), cuts)
-                    if not chk.converged:
-                        att = Attempt(False, att.u, att.lam, att.iterations, att.residuals, chk.message)
-                if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
-                    u_new, res = newton(problem, u, end, s)
-                    if res.converged:
-                        att = Attempt(True, u_new, end, att.iterations + res.iterations,
-                                      att.residuals + res.residuals)
-                        to_end = True
-                    elif end_cuts < END_CUTS:
-                        end_cuts += 1
-                        # load control has no equilibrium at λ_end from here: the increment passed a
-                        # snap-back on its way beyond λ_end (the MITC9 plate on 12 × 12: from 0.982
-                        # through the flap's debonding to 1.0245 in one increment). Shorter ones end
-                        # past the snap-back and below λ_end, from where λ_end is reached
-                        att = Attempt(False, att.u, att.lam, att.iterations + res.iterations,
-                                      att.residuals + res.residuals,
-                                      f"the increment passes λ_end = {end:g} (to {att.lam:.6g}), where load "
-                                      f"control from {lam:.6g} finds no equilibrium ({res.message})")
             total_it += att.iterations
             residuals += att.residuals
-            ok = att.converged
-            msg = att.message
+            ok, why, msg = att.converged, att.reason, att.message
             if ok and friction:
                 fric_c1 = friction_excess(problem, att.u)[0]
             if ok and on_step_end is not None:
@@ -853,10 +749,11 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     resolves += 1
                     if (not allow_jump and a0 is not None and ps.jump_area is not None
                             and measure(problem) - a0 > ps.jump_area):
-                        ok, msg = False, "debonding jump"
+                        ok, why, msg = False, Reason.DEBONDING_JUMP, Reason.DEBONDING_JUMP.message
                         break
                     if resolves > max_resolves:
-                        ok, msg = False, f"the state still changes after {max_resolves} re-solutions"
+                        ok, why = False, Reason.STILL_CHANGING
+                        msg = f"the state still changes after {max_resolves} re-solutions"
                         break
                     if st.mode == "load" or to_end:
                         # as load_steps (contact_to_nodes); a failure cuts the increment instead of settling
@@ -868,56 +765,19 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     total_it += att.iterations
                     residuals += att.residuals
                     if not att.converged:
-                        ok, msg = False, att.message
+                        ok, why, msg = False, att.reason, att.message
                         break
                     if friction:
                         fric_c1 = friction_excess(problem, att.u)[0]
-            if (ok and st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
-                    and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
-                ok, msg = False, "the increment turned back along the path"  # cut; accepted after 3 cuts
-            if (ok and st.mode == "arc" and not displacement_path and lam == st.lam_damaged
-                    and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
-                # from a state whose increment damaged, the arc length found the elastic unloading
-                # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
-                # elements, its crack past the load point, would go from λ = 0.6078 down so,
-                # 'unloads without damage'): the dissipation constraint next, which demands damage
-                ok, msg = False, "the increment unloads elastically from a debonding state"
-            if ok and ledger0 is not None and st.mode == "dissipation":
-                # the constraint takes the stored energy to be the secant one; where the structure
-                # unloads stiffer than the secant (crack faces closing, contact, friction) an
-                # elastic path meets it without damage - the prescribed opening of the DCB on 100
-                # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
-                # own ledger must book the dissipation. On displacement paths all of it counts; on
-                # force paths only damage, and only where the load falls (friction's work on
-                # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
-                # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
-                # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
-                # (Counting rising force increments too would refuse the lap shear with friction's
-                # unloading past its peak, which `unloading` below stops with a clearer message.)
-                # A refused increment is cut, then tried by the arc length, then by a rescue
-                if displacement_path:
-                    if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
-                        ok, msg = False, "the dissipation constraint was met by closure, not damage"
-                elif (att.lam < lam and problem.interfaces.cohesive()
-                      and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
-                    ok, msg = False, FRICTION_REFUSED
-            if ok and st.mode == "dissipation" and lam * att.lam < 0.0:
-                # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
-                # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
-                # through closure meets the constraint without any damage (the force-loaded DCB
-                # on 150 elements would 'converge' from λ = 0.42 to -0.03 with its arms shut)
-                ok, msg = False, "the dissipation constraint crossed λ = 0 (closure, not damage)"
-            if (ok and arc and st.mode == "load" and not allow_jump and measure is not None and ps.jump_area is not None
-                    and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
-                # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
-                # it passes (half of the slab's interface debonding at once, no re-solution to see
-                # it in) shows only in the converged increment's debonded area
-                ok, msg = False, "debonding jump"
-            if ok and not allow_jump and watch is not None and ps.jump_ratio is not None:
-                if jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
-                                 scales, floors(att.u) if floors is not None else None):
-                    ok, msg = False, "probe jump"
-            if ok and b0 is not None and (st.mode != "load" or rescue is None):
+            refused = (_constraint_refusal(problem, st, att, u, lam, to_end, cuts, ledger0, displacement_path)
+                       if ok else None)
+            if refused is not None:  # it meets its constraint for the wrong reason
+                ok, why, msg = False, refused, refused.message
+            refused = (_jumped(problem, st, ps, att, n, lam, measure, area_prev, watch, probes_prev, floors)
+                       if ok and not allow_jump else None)
+            if refused is not None:
+                ok, why, msg = False, refused, refused.message
+            if ok and b0 is not None and (st.mode != "load" or not st.rescue):
                 # (b0: arc-length control; its stretches of load-controlled increments too - the
                 # MMB's second rise to λ = 1, its crack still growing, takes increments too long for
                 # the ledger without it: balance 1.8 % - but not a rescue, where a load-controlled increment
@@ -925,16 +785,16 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # which shorter increments do not resolve)
                 e_rel = energy_control(b0, balance_terms(problem, att.u), ps.energy_tolerance)
                 if e_rel > 1.0 and cuts < ps.max_energy_cuts:
-                    ok, msg = False, "energy balance"
+                    ok, why, msg = False, Reason.ENERGY_BALANCE, Reason.ENERGY_BALANCE.message
             if ok:
                 break
             if snap is not None:
                 problem.restore(snap)
-            if msg == "energy balance":  # a converged increment too long for the ledger: shorter, same control
+            if why is Reason.ENERGY_BALANCE:  # a converged increment too long for the ledger: shorter, same control
                 cuts += 1
                 st.size *= max(0.25, min(0.5, 0.8 / e_rel))
                 continue
-            if msg == FRICTION_REFUSED and _friction_acts(problem):
+            if why is Reason.FRICTION_REFUSED and _friction_acts(problem):
                 # too short an increment to damage: the constraint (secant unloading) is met by
                 # the energy that the friction's stick springs and the contact give back - a longer
                 # one damages. On the TRC slab's snap-back (16 × 12, 305.90 kN/m²) increments of
@@ -950,7 +810,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     continue
                 if size_refused:
                     st.size, size_refused = size_refused, 0.0
-            if st.mode == "dissipation" and msg.startswith("no dissipation"):
+            if st.mode == "dissipation" and why is Reason.NO_DISSIPATION:
                 # elastic branch: back to the arc length, its direction by the work criterion -
                 # the previous direction (a snap-back: load and displacement falling while the
                 # crack grew) would now follow elastic unloading down to λ = 0 (the DCB on 100
@@ -973,18 +833,18 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
             cuts += 1
             small = ((st.mode == "load" and st.size * 0.5 < inc_min)
                      or (st.mode == "arc" and st.size * 0.5 < dl_min))
-            jump = msg in ("debonding jump", "probe jump")
+            jump = why.jump
             limit = cuts > ps.max_cuts or small or (jump and cuts > ps.max_jump_cuts)
-            if arc and st.mode == "load" and rescue is None and (jump or cuts > STRETCH_CUTS or limit):
+            if arc and st.mode == "load" and not st.rescue and (jump or cuts > STRETCH_CUTS or limit):
                 # a stretch of load-controlled increments ends where one does not converge within
                 # STRETCH_CUTS halvings, or jumps (a snap-back, or a peak): the arc length again
                 # from the last state, its direction by the work criterion
-                if stretch_accepted:
+                if st.stretch_accepted:
                     warns.append(f"step {n}: load-controlled increments took the path from load factor "
-                                 f"{stretch_from:.6g} to {lam:.6g}; from there the arc length again (the next "
+                                 f"{st.stretch_from:.6g} to {lam:.6g}; from there the arc length again (the next "
                                  f"load-controlled increment: {msg})")
                 # (no new stretch until the arc length has passed the load the last failed increment aimed at)
-                stretch_block, stretch_accepted = lam + st.size, 0
+                st.stretch_block, st.stretch_accepted = lam + st.size, 0
                 st.mode, st.size, st.changed, cuts = "arc", st.arc_length, True, 0
                 continue
             if st.mode == "load" and s.unstable == "relax" and not jump and (cuts > ps.relax_after_cuts or limit):
@@ -999,52 +859,25 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                     st.size = size0  # the jump is behind: the size before the cuts, halved below
                     break
             if limit:
-                if jump and rescue is not None:  # a load-controlled rescue may not jump a snap-back
-                    raise ConvergenceError(
-                        rescue + f"; a load-controlled increment from it jumps ({msg} at every size down to "
-                        f"Δλ = {st.size:.3g}): the path snaps back there. Load control with [steps] unstable = "
-                        "'relax' passes the jump at a fixed load and reports the energy it releases",
-                        lam, residuals[-1] if residuals else float("nan"))
-                if jump:
-                    allow_jump = True  # cutting does not help: accept the jump, with a warning
-                    continue
-                if st.mode == "dissipation":  # once per increment: then the arc length alone
-                    # its direction by the work criterion, as after "no dissipation" above: past a
-                    # snap-back the previous direction follows elastic unloading down to λ = 0.
-                    # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
-                    st.mode, st.changed = "arc", True
-                    st.size = arc_length_restart(st.arc_length, st.arc_length0, dl_max)
-                    cuts, tried_dissipation = 0, True
-                    continue
-                if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
+                then = _at_the_limit(problem, st, s, ps, n, lam, u, step0, cuts, jump, msg, size0, residuals)
+                if then is _Then.END:
                     return  # complete failure: nothing left to carry the load (the tangent is singular)
-                if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
-                    cuts, st.size = 0, ps.increment  # as load_steps: viscous from the converged state on
-                    continue
-                if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
-                    cuts, st.size = 0, size0  # as load_steps: the thesis's contact at the nodes from here on
-                    continue
-                if rescue is not None:  # the load-controlled increment did not pass either
-                    raise ConvergenceError(rescue + f"; a load-controlled increment from it found no equilibrium "
-                                           f"either ({msg})", lam, residuals[-1] if residuals else float("nan"))
-                stop = (f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step cuts ({msg}); the "
-                        f"last converged load factor is {lam:.6g}"
-                        + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem))
-                if st.mode != "load" and _may_rescue(ps, arc, lam):
-                    rescue, st.mode, st.size, cuts = stop, "load", _rescue_increment(ps, lam), 0  # see the crawl below
-                    continue
-                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
+                if then is _Then.ACCEPT_JUMP:
+                    allow_jump = True  # cutting does not help: accept the jump, with a warning
+                else:
+                    cuts, tried_dissipation = 0, tried_dissipation or then is _Then.ARC
+                continue
             st.size *= 0.5
         # accepted increment
         commit_state(problem, att.u)
-        implex_last = (st.mode, abs(att.lam - lam) if st.mode == "load" else st.size)
+        st.implex_mode, st.implex_size = st.mode, abs(att.lam - lam) if st.mode == "load" else st.size
         du = att.u - u
         dlam = att.lam - lam
         conj = conjugates(problem, att.u) if displacement_path else None  # (v, R) at the new state
-        if displacement_path and reaction is None:
-            reaction = conjugates(problem, u)[1]  # R at the start (first increment, restart)
+        if displacement_path and math.isnan(st.reaction):
+            st.reaction = conjugates(problem, u)[1]  # R at the start (first increment)
         dG = dissipation_increment(problem, u, lam, du, dlam, f_itf0,
-                                   None if conj is None else (reaction, conj[1]),
+                                   None if conj is None else (st.reaction, conj[1]),
                                    (fric_c0, fric_c1) if friction else None)
         st.dissipated += dG
         # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
@@ -1053,147 +886,341 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
-                               probe_scales(scales, probes), floors(att.u) if floors is not None else None)
+                               probe_scales(st.scales, probes), floors(att.u) if floors is not None else None)
         area_prev, probes_prev = area, probes
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
-        its = max(att.iterations, 1)
-        used = abs(dlam) if st.mode == "load" else st.size  # the size of this increment
-        history = st.recent if st.recent_mode == st.mode else []  # the last ones under this constraint
-        fac = min(2.0, max(0.5, ps.target_iterations / its))
-        if cuts:
-            fac = min(fac, 1.0)  # no growth right after a cut
-        elif (st.mode == "dissipation" and friction and used < DISSIPATION_INSENSITIVE_BELOW * st.dissipation_max
-              and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
-            # as below, where friction acts: each commit moves the friction's anchors and limits,
-            # and the count no longer falls with the size (without this the lap shear with alpha_T = 1e5
-            # holds Δτ at 0.2-0.7, 1/100 of its largest, by 8 iterations each: 703 instead of 142 increments)
-            fac = max(fac, INSENSITIVE_GROWTH)
-        elif (st.mode in ("load", "arc")
-              # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
-              # increments at any size (the slab on 16 × 12 takes 6-10 iterations at Δλ = 0.4-5
-              # kN/m², and the plain rule would shrink them from 5 to 0.4)
-              and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
-                   or (arc and st.mode == "load"))
-              and size_insensitive(used, its, history, ps.target_iterations)):
-            fac = max(fac, INSENSITIVE_GROWTH)
-        if st.mode in ("load", "arc"):
-            st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
-            st.recent_mode = st.mode
-        elif friction:
-            st.recent_dissipation = (st.recent_dissipation + [(used, its)])[-ARC_WINDOW:]
-            st.dissipation_max = max(st.dissipation_max, used)
-        if e_rel > 0.5:
-            fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
-        if st.mode == "load":
-            st.size = min(max(st.size * fac, inc_min), inc_max)
-        elif st.mode == "arc":
-            st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
-            elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
-            floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
-            if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
-                st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
-        else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
-            # down where this one was longer (else a short bond's peak lies inside one increment)
-            dun = increment_length(problem, du)
-            st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
-            st.arc_length = max(min(dun, dl_max), dl_min)
-            if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
-                # nothing left to dissipate (the interface has separated, the reaction vanished):
-                # the prescribed displacement goes on elastically, by the arc length
-                st.mode, st.size = "arc", st.arc_length
+        _next_size(problem, st, ps, att, abs(dlam) if st.mode == "load" else st.size, cuts, e_rel, dG, du, conj,
+                   friction, displacement_path, (inc_min, inc_max, dl_min, dl_max))
         st.du_prev = du
         st.changed = resolves > 0  # the next direction by the work criterion
-        if rescue is not None:  # the load-controlled increment passed the crawl: a stretch of them goes on
-            warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
-                         f"crawled or found no equilibrium); one load-controlled increment passed it to "
-                         f"{att.lam:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
-                         "had no solution); load-controlled increments go on while they converge without a jump")
-            rescue, stretch_from, stretch_accepted = None, lam, 1
-        elif arc and st.mode == "load":
-            if not stretch_accepted:
-                stretch_from = lam
-            stretch_accepted += 1
-            if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
-                # to it otherwise: the slab on 16 × 12 would go 323.5, 324.9, 325.29, 325.44, 325.456,
-                # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
-                which = "one load-controlled increment" if stretch_accepted == 1 else "load-controlled increments"
-                warns.append(f"step {n}: {which} took the path from load factor {stretch_from:.6g} to {att.lam:.6g}, "
-                             f"on a rising branch where the arc length's increments needed cuts; from there the "
-                             f"arc length again (this increment needed {cuts} halving(s))")
-                stretch_block, stretch_accepted = att.lam + abs(att.lam - lam), 0
-                st.mode, st.size, st.changed = "arc", st.arc_length, True
-            elif stretch_accepted == 1:
-                warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
-                             f"increments needed cuts, load-controlled increments go on while they converge "
-                             f"without a jump (to {att.lam:.6g} in this one)")
+        _stretch_bookkeeping(st, n, lam, att.lam, cuts, arc, warns)
         u, lam = att.u, att.lam
-        reaction = conj[1] if conj is not None else None
+        st.reaction = conj[1] if conj is not None else math.nan
         peak_before, st.lam_peak = st.lam_peak, max(st.lam_peak, abs(lam))
         if (st.mode in ("arc", "dissipation") and stretch_may_start(ps, arc, displacement_path, cuts, lam, dlam,
-                                                                     peak_before, stretch_block)):
-            st.mode, st.size, stretch_accepted = "load", _rescue_increment(ps, lam), 0
-        grew = dD is not None and not displacement_path and beyond_round_off(dD, damage)
-        if grew:
-            st.lam_damaged = lam  # on the debonding branch (a stretch's load-controlled increments too)
-        if st.mode == "load":
-            st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
-        else:
-            st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
-                           or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
-                                               st.dissipated, ps.end_fraction))
-            if (dD is not None and not displacement_path and not grew and not st.finished
-                    and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak)):
-                raise ConvergenceError(
-                    f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
-                    f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
-                    f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
-                    f"the branch on which the interfaces debond - past a snap-back its constrained "
-                    f"iterations found no state with damage growth. The states up to here are kept; the "
-                    f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
-                    f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
-                    f"load and reports the energy it releases; or refine the mesh along the debonding front",
-                    lam, residuals[-1] if residuals else float("nan"))
-        recent = (recent + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
-        recent_dG = (recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
-        crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
-                 and crawling(recent, recent_dG, ps.stall_increments, st.lam_peak, st.dissipated, ps.end_fraction))
-        if (not st.finished and st.mode != "load"
-                and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
-            st.finished = True
-            warns.append(f"step {n}: the load factor stayed within {max(recent) - min(recent):.3g} of "
-                         f"{lam:.4g} ({100 * abs(lam) / st.lam_peak:.2g} % of its peak {st.lam_peak:.4g}) over the "
-                         f"last {len(recent)} increments: the path ends as complete failure")
-        end_reason = None
-        if st.finished:
-            end_reason = "lambda_end" if lam >= end - 1e-12 * max(1.0, abs(end)) else "complete failure"
-        elif n == ps.max_steps:
-            st.finished, end_reason = True, "max_steps"
+                                                                     peak_before, st.stretch_block)):
+            st.mode, st.size, st.stretch_accepted = "load", _rescue_increment(ps, lam), 0
+        end_reason, crawl = _path_end(problem, st, ps, n, lam, dlam, du, dG, dD, damage, to_end, displacement_path,
+                                      residuals, warns)
+        if crawl and _may_rescue(ps, arc, lam):
+            # one load-controlled increment next (Newton with its own active-set loop, which passes states
+            # where the constrained iterations on frozen sets have no solution), as long as λ rises
+            st.rescue, st.mode, st.size = crawl, "load", _rescue_increment(ps, lam)
+            st.recent_lams, st.recent_dG = [], []
         check_stabilised_step(problem, n, lam, e0, s.stabilize_limit)
         res = StepResult(n, lam, u.copy(), total_it, residuals, cuts, time.perf_counter() - t0,
                          start_inertia(problem))
-        res.state = replace(st, du_prev=None if st.du_prev is None else st.du_prev.copy(),
-                            recent=list(st.recent), recent_dissipation=list(st.recent_dissipation))  # (a copy of every field, so that a
-        # restart from the checkpoint has all of them, lam_damaged included)
+        res.state = st.copy()  # the state after this increment (the checkpoint stores it whole)
         res.warnings = warns
         res.dissipation = dG
-        res.end = end_reason  # why the path ends here ("lambda_end", "complete failure", "max_steps"), else None
+        res.end = end_reason  # why the path ends here (an End), else None
         yield res
         if st.finished:
             return
-        if crawl:  # after the step is kept: the path cannot go on from it by the arc length
-            stop = (f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
-                    f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
-                    f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
-                    f"dissipated so far; the constrained iterations fail at every larger increment. The last converged "
-                    f"state is kept. Where the path is expected to rise to the design load, load control "
-                    f"(control = 'load') with [steps] stabilize passes such a state; else refine the mesh at the "
-                    f"debonding front")
-            if not _may_rescue(ps, arc, lam):
-                raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
-            # one load-controlled increment (Newton with its own active-set loop, which passes states
-            # where the constrained iterations on frozen sets have no solution), as long as λ rises
-            rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)
-            recent, recent_dG = [], []
+        if crawl and not st.rescue:  # after the step is kept: the path cannot go on from it
+            raise ConvergenceError(crawl, lam, residuals[-1] if residuals else float("nan"))
+
+
+class _Then(Enum):
+    """What follows an increment cut to its limit (:func:`_at_the_limit`)."""
+
+    ACCEPT_JUMP = 1  # cutting does not help: accept the jump, with a warning
+    ARC = 2  # the arc length alone from here, uncut
+    RETRY = 3  # the same increment again, uncut, in a changed setting (constraint, stabilisation, contact)
+    END = 4  # complete failure: the path ends
+
+
+def _at_the_limit(problem: Problem, st: PathState, s: NewtonSettings, ps: PathSettings, n: int, lam: float,
+                  u: np.ndarray, step0: int, cuts: int, jump: bool, msg: str, size0: float,
+                  residuals: list[float]) -> "_Then":
+    """An increment from (``u``, ``lam``) cut ``cuts`` times to its limit (``jump``: it jumped;
+    ``msg``: why its last try failed; ``size0``: its size before the cuts): what follows, or
+    ConvergenceError where nothing is left to try."""
+    arc = ps.control == "arc_length"
+    dl_max = ps.arc_length_max if ps.arc_length_max is not None else 10.0 * st.arc_length0
+    if jump and st.rescue:  # a load-controlled rescue may not jump a snap-back
+        raise ConvergenceError(
+            st.rescue + f"; a load-controlled increment from it jumps ({msg} at every size down to "
+            f"Δλ = {st.size:.3g}): the path snaps back there. Load control with [steps] unstable = "
+            "'relax' passes the jump at a fixed load and reports the energy it releases",
+            lam, residuals[-1] if residuals else float("nan"))
+    if jump:
+        return _Then.ACCEPT_JUMP
+    if st.mode == "dissipation":  # once per increment: then the arc length alone
+        # its direction by the work criterion, as after "no dissipation" above: past a
+        # snap-back the previous direction follows elastic unloading down to λ = 0.
+        # Its length: at least ARC_AFTER_DISSIPATION of the first (arc_length_restart)
+        st.mode, st.changed = "arc", True
+        st.size = arc_length_restart(st.arc_length, st.arc_length0, dl_max)
+        return _Then.ARC
+    if st.lam_peak > 0 and abs(lam) <= ps.end_fraction * st.lam_peak and n > step0 + 1:
+        return _Then.END
+    if st.mode == "load" and stabilise(problem, s, ps.increment, lam):
+        st.size = ps.increment  # as load_steps: viscous from the converged state on
+        return _Then.RETRY
+    if contact_to_nodes(problem, u, lam, f"from load factor {lam:.6g} after {cuts} step cuts: {msg}"):
+        st.size = size0  # as load_steps: the thesis's contact at the nodes from here on
+        return _Then.RETRY
+    if st.rescue:  # the load-controlled increment did not pass either
+        raise ConvergenceError(st.rescue + f"; a load-controlled increment from it found no equilibrium "
+                               f"either ({msg})", lam, residuals[-1] if residuals else float("nan"))
+    stop = (f"step {n}: no equilibrium from load factor {lam:.6g} after {cuts} step cuts ({msg}); the "
+            f"last converged load factor is {lam:.6g}"
+            + (cohesive_hint(problem, s) if st.mode == "load" else "") + contact_hint(problem))
+    if st.mode != "load" and _may_rescue(ps, arc, lam):
+        st.rescue, st.mode, st.size = stop, "load", _rescue_increment(ps, lam)  # as after a crawl
+        return _Then.RETRY
+    raise ConvergenceError(stop, lam, residuals[-1] if residuals else float("nan"))
+
+
+def _try_increment(problem: Problem, st: PathState, s: NewtonSettings, ps: PathSettings, u: np.ndarray, lam: float,
+                   cuts: int, f_itf0: np.ndarray | None) -> tuple[Attempt, bool]:
+    """One try of the next increment from (``u``, ``lam``) under the constraint ``st.mode`` of
+    size ``st.size`` (``cuts``: its halvings so far): the Attempt, and whether it ends at λ_end
+    (an arc-length increment that passes λ_end is replaced by a load-controlled one to it)."""
+    end = ps.lambda_end
+    to_end = False
+    # IMPL-EX: the damage rate of the last accepted increment scaled to this one's size
+    next_increment(problem, ratio=(st.size / st.implex_size if st.implex_mode == st.mode
+                                   and st.implex_size > 0 else 1.0))
+    if st.mode == "load":
+        dlam = min(st.size, end - lam)
+        to_end = lam + dlam >= end - 1e-12 * max(1.0, abs(end))
+        trial = end if to_end else lam + dlam
+        u_new, res = implex_checked(problem, newton(problem, u, trial, s), cuts)
+        att = Attempt(res.converged, u_new, trial, res.iterations, res.residuals, res.message)
+    else:
+        att = arc_attempt(problem, u, lam, st.size, st.mode, None if st.changed else st.du_prev, s, ps,
+                          max(st.lam_peak, abs(lam)), f_itf0)
+        if att.converged:
+            _, chk = implex_checked(problem, (att.u, NewtonResult(True, att.iterations, att.residuals)), cuts)
+            if not chk.converged:
+                att = Attempt(False, att.u, att.lam, att.iterations, att.residuals, chk.message)  # (IMPL-EX)
+        if att.converged and att.lam > end and lam < end:  # passes λ_end: the last increment to it
+            u_new, res = newton(problem, u, end, s)
+            if res.converged:
+                att = Attempt(True, u_new, end, att.iterations + res.iterations,
+                              att.residuals + res.residuals)
+                to_end = True
+            elif st.end_cuts < END_CUTS:
+                st.end_cuts += 1
+                # load control has no equilibrium at λ_end from here: the increment passed a
+                # snap-back on its way beyond λ_end (the MITC9 plate on 12 × 12: from 0.982
+                # through the flap's debonding to 1.0245 in one increment). Shorter ones end
+                # past the snap-back and below λ_end, from where λ_end is reached
+                att = Attempt(False, att.u, att.lam, att.iterations + res.iterations,
+                              att.residuals + res.residuals,
+                              f"the increment passes λ_end = {end:g} (to {att.lam:.6g}), where load "
+                              f"control from {lam:.6g} finds no equilibrium ({res.message})",
+                              reason=Reason.PASSES_END)
+    return att, to_end
+
+
+def _jumped(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, n: int, lam: float,
+            measure: Callable | None, area_prev: float | None, watch: Callable | None,
+            probes_prev: dict | None, floors: Callable | None) -> Reason | None:
+    """Whether the converged increment ``att`` (number ``n``, from ``lam``) jumps: a stretch's
+    load-controlled increment whose debonded area (``measure``) grew by more than ``jump_area``
+    since ``area_prev``, or a watched probe that grew more than ``jump_ratio`` times faster than λ
+    (:func:`jump_warnings`)."""
+    if (ps.control == "arc_length" and st.mode == "load" and measure is not None and ps.jump_area is not None
+            and area_prev is not None and measure(problem) - area_prev > ps.jump_area):
+        # a rescue's (a stretch's) Newton solve updates the cohesive sets itself: a snap-back
+        # it passes (half of the slab's interface debonding at once, no re-solution to see
+        # it in) shows only in the converged increment's debonded area
+        return Reason.DEBONDING_JUMP
+    if (watch is not None and ps.jump_ratio is not None
+            and jump_warnings(n, att.lam, lam, None, None, watch(att.u, att.lam), probes_prev, None, ps.jump_ratio,
+                              st.scales, floors(att.u) if floors is not None else None)):
+        return Reason.PROBE_JUMP
+    return None
+
+
+def _constraint_refusal(problem: Problem, st: PathState, att: Attempt, u: np.ndarray, lam: float, to_end: bool,
+                        cuts: int, ledger0: tuple[float, float] | None, displacement_path: bool) -> Reason | None:
+    """Why the converged increment ``att`` from (``u``, ``lam``) is refused although it meets its
+    constraint (it turned back, unloads elastically from a debonding state, or met the dissipation
+    constraint without damage), else None. ``ledger0``: the interfaces' ledger at its start."""
+    if (st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
+            and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
+        return Reason.TURNED_BACK  # cut; accepted after 3 cuts
+    if (st.mode == "arc" and not displacement_path and lam == st.lam_damaged
+            and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
+        # from a state whose increment damaged, the arc length found the elastic unloading
+        # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
+        # elements, its crack past the load point, would go from λ = 0.6078 down so,
+        # 'unloads without damage'): the dissipation constraint next, which demands damage
+        return Reason.ELASTIC_UNLOADING
+    if ledger0 is not None and st.mode == "dissipation":
+        # the constraint takes the stored energy to be the secant one; where the structure
+        # unloads stiffer than the secant (crack faces closing, contact, friction) an
+        # elastic path meets it without damage - the prescribed opening of the DCB on 100
+        # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
+        # own ledger must book the dissipation. On displacement paths all of it counts; on
+        # force paths only damage, and only where the load falls (friction's work on
+        # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
+        # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
+        # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
+        # (Counting rising force increments too would refuse the lap shear with friction's
+        # unloading past its peak, which `unloading` below stops with a clearer message.)
+        # A refused increment is cut, then tried by the arc length, then by a rescue
+        if displacement_path:
+            if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
+                return Reason.CLOSURE_REFUSED
+        elif (att.lam < lam and problem.interfaces.cohesive()
+              and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
+            return Reason.FRICTION_REFUSED
+    if st.mode == "dissipation" and lam * att.lam < 0.0:
+        # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
+        # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
+        # through closure meets the constraint without any damage (the force-loaded DCB
+        # on 150 elements would 'converge' from λ = 0.42 to -0.03 with its arms shut)
+        return Reason.CROSSED_ZERO
+    return None
+
+
+def _next_size(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, used: float, cuts: int,
+               e_rel: float, dG: float, du: np.ndarray, conj: tuple[float, float] | None, friction: bool,
+               displacement_path: bool, bounds: tuple[float, float, float, float]) -> None:
+    """The constraint and size of the next increment after an accepted one of size ``used`` (Δλ,
+    Δl or Δτ) in ``att.iterations`` Newton iterations and ``cuts`` halvings: grow after easy
+    increments, shrink after hard ones (Crisfield 1981), aim below the energy tolerance
+    (``e_rel``), switch to the dissipation constraint where the increment dissipated (Verhoosel et
+    al. 2009) and back to the arc length where nothing is left to dissipate. ``bounds``: the
+    smallest and largest Δλ and Δl."""
+    inc_min, inc_max, dl_min, dl_max = bounds
+    arc = ps.control == "arc_length"
+    its = max(att.iterations, 1)
+    history = st.recent if st.recent_mode == st.mode else []  # the last ones under this constraint
+    fac = min(2.0, max(0.5, ps.target_iterations / its))
+    if cuts:
+        fac = min(fac, 1.0)  # no growth right after a cut
+    elif (st.mode == "dissipation" and friction and used < DISSIPATION_INSENSITIVE_BELOW * st.dissipation_max
+          and size_insensitive(used, its, st.recent_dissipation, ps.target_iterations)):
+        # as below, where friction acts: each commit moves the friction's anchors and limits,
+        # and the count no longer falls with the size (without this the lap shear with alpha_T = 1e5
+        # holds Δτ at 0.2-0.7, 1/100 of its largest, by 8 iterations each: 703 instead of 142 increments)
+        fac = max(fac, INSENSITIVE_GROWTH)
+    elif (st.mode in ("load", "arc")
+          # below INSENSITIVE_BELOW of the first increment; a stretch of load-controlled
+          # increments at any size (the slab on 16 × 12 takes 6-10 iterations at Δλ = 0.4-5
+          # kN/m², and the plain rule would shrink them from 5 to 0.4)
+          and (used < INSENSITIVE_BELOW * (st.arc_length0 if st.mode == "arc" else ps.increment)
+               or (arc and st.mode == "load"))
+          and size_insensitive(used, its, history, ps.target_iterations)):
+        fac = max(fac, INSENSITIVE_GROWTH)
+    if st.mode in ("load", "arc"):
+        st.recent = (history + [(used, its)])[-(ARC_WINDOW if arc else 1):]
+        st.recent_mode = st.mode
+    elif friction:
+        st.recent_dissipation = (st.recent_dissipation + [(used, its)])[-ARC_WINDOW:]
+        st.dissipation_max = max(st.dissipation_max, used)
+    if e_rel > 0.5:
+        fac = min(fac, max(0.25, 0.8 / e_rel))  # aim below the energy tolerance (its error ∝ the length)
+    if st.mode == "load":
+        st.size = min(max(st.size * fac, inc_min), inc_max)
+    elif st.mode == "arc":
+        st.size = st.arc_length = min(max(st.size * fac, dl_min), dl_max)
+        elastic = 0.5 * abs(att.lam * sum(conj if conj is not None else conjugates(problem, att.u)))
+        floor = ELASTIC_INCREMENT * st.dissipated if displacement_path else 0.0
+        if ps.dissipation and dG > ps.dissipation_threshold * elastic and dG > floor:
+            st.mode, st.size = "dissipation", dG  # Verhoosel et al. 2009: energy is dissipated
+    else:  # arc_length_max bounds the dissipation-controlled increments too: the next Δτ is scaled
+        # down where this one was longer (else a short bond's peak lies inside one increment)
+        dun = increment_length(problem, du)
+        st.size = st.size * fac * min(1.0, dl_max / max(dun, 1e-300))
+        st.arc_length = max(min(dun, dl_max), dl_min)
+        if displacement_path and dG <= ELASTIC_INCREMENT * st.dissipated:
+            # nothing left to dissipate (the interface has separated, the reaction vanished):
+            # the prescribed displacement goes on elastically, by the arc length
+            st.mode, st.size = "arc", st.arc_length
+
+
+def _stretch_bookkeeping(st: PathState, n: int, lam: float, lam_new: float, cuts: int, arc: bool,
+                         warns: list[str]) -> None:
+    """After increment ``n`` from ``lam`` to ``lam_new``: a load-controlled rescue that passed
+    starts a stretch of load-controlled increments under arc-length control; a stretch counts
+    its increments and ends (the arc length again) at one that needed a cut. Warnings to ``warns``."""
+    if st.rescue:  # the load-controlled increment passed the crawl: a stretch of them goes on
+        warns.append(f"step {n}: the arc length could not go on from load factor {lam:.6g} (its increments "
+                     f"crawled or found no equilibrium); one load-controlled increment passed it to "
+                     f"{lam_new:.6g} (a rising branch, where the constrained iterations on frozen cohesive sets "
+                     "had no solution); load-controlled increments go on while they converge without a jump")
+        st.rescue, st.stretch_from, st.stretch_accepted = "", lam, 1
+    elif arc and st.mode == "load":
+        if not st.stretch_accepted:
+            st.stretch_from = lam
+        st.stretch_accepted += 1
+        if cuts:  # a load-controlled increment that needed a halving: near a peak (Zeno's approach
+            # to it otherwise: the slab on 16 × 12 would go 323.5, 324.9, 325.29, 325.44, 325.456,
+            # 325.465 kN/m², each with 1-2 halvings and 100-200 iterations): the arc length from here
+            which = "one load-controlled increment" if st.stretch_accepted == 1 else "load-controlled increments"
+            warns.append(f"step {n}: {which} took the path from load factor {st.stretch_from:.6g} to {lam_new:.6g}, "
+                         f"on a rising branch where the arc length's increments needed cuts; from there the "
+                         f"arc length again (this increment needed {cuts} halving(s))")
+            st.stretch_block, st.stretch_accepted = lam_new + abs(lam_new - lam), 0
+            st.mode, st.size, st.changed = "arc", st.arc_length, True
+        elif st.stretch_accepted == 1:
+            warns.append(f"step {n}: from load factor {lam:.6g}, on a rising branch where the arc length's "
+                         f"increments needed cuts, load-controlled increments go on while they converge "
+                         f"without a jump (to {lam_new:.6g} in this one)")
+
+
+def _path_end(problem: Problem, st: PathState, ps: PathSettings, n: int, lam: float, dlam: float, du: np.ndarray,
+              dG: float, dD: float | None, damage: float | None, to_end: bool, displacement_path: bool,
+              residuals: list[float], warns: list[str]) -> tuple[End | None, str]:
+    """After increment ``n`` (to ``lam``, by ``dlam`` and ``du``, dissipating ``dG``; ``dD``: the
+    damage the interfaces' ledger booked in it, of ``damage`` so far): whether the path ends here
+    (``st.finished`` and the End, else None), and the stop message where its increments crawl
+    ("" otherwise). ConvergenceError where a force path unloads without damage."""
+    end = ps.lambda_end
+    grew = dD is not None and not displacement_path and beyond_round_off(dD, damage)
+    if grew:
+        st.lam_damaged = lam  # on the debonding branch (a stretch's load-controlled increments too)
+    if st.mode == "load":
+        st.finished = lam >= end - 1e-12 * max(1.0, abs(end))
+    else:
+        st.finished = (to_end or lam >= end  # complete failure: λ fell in an increment that damaged
+                       or complete_failure(lam, dlam, st.lam_peak, dG if dD is None else dD,
+                                           st.dissipated, ps.end_fraction))
+        if (dD is not None and not displacement_path and not grew and not st.finished
+                and unloading(lam, dlam, float(problem.F_scaled @ du), st.lam_damaged, st.lam_peak)):
+            raise ConvergenceError(
+                f"step {n}: from load factor {st.lam_damaged:.6g} the path unloads without damage "
+                f"(λ = {lam:.6g} now, {100 * (st.lam_damaged - lam) / st.lam_peak:.3g} % of its peak "
+                f"{st.lam_peak:.6g} lower; friction or elastic unloading only): the arc length has lost "
+                f"the branch on which the interfaces debond - past a snap-back its constrained "
+                f"iterations found no state with damage growth. The states up to here are kept; the "
+                f"last with damage growth is at load factor {st.lam_damaged:.6g}. Load control "
+                f"(control = 'load') with [steps] unstable = 'relax' passes the snap-back at a fixed "
+                f"load and reports the energy it releases; or refine the mesh along the debonding front",
+                lam, residuals[-1] if residuals else float("nan"))
+    st.recent_lams = (st.recent_lams + [lam])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+    st.recent_dG = (st.recent_dG + [abs(dG)])[-ps.stall_increments:] if ps.stall_increments > 0 else []
+    recent, recent_dG = st.recent_lams, st.recent_dG
+    crawl = (not st.finished and st.mode != "load" and n < ps.max_steps
+             and crawling(recent, recent_dG, ps.stall_increments, st.lam_peak, st.dissipated, ps.end_fraction))
+    if (not st.finished and st.mode != "load"
+            and stalled(recent, ps.stall_increments, st.lam_peak, ps.end_fraction)):
+        st.finished = True
+        warns.append(f"step {n}: the load factor stayed within {max(recent) - min(recent):.3g} of "
+                     f"{lam:.4g} ({100 * abs(lam) / st.lam_peak:.2g} % of its peak {st.lam_peak:.4g}) over the "
+                     f"last {len(recent)} increments: the path ends as complete failure")
+    end_reason = None
+    if st.finished:
+        end_reason = End.LAMBDA_END if lam >= end - 1e-12 * max(1.0, abs(end)) else End.COMPLETE_FAILURE
+    elif n == ps.max_steps:
+        st.finished, end_reason = True, End.MAX_STEPS
+    if not crawl:
+        return end_reason, ""
+    return end_reason, (
+        f"step {n + 1}: the path no longer advances from load factor {lam:.6g} ({100 * abs(lam) / st.lam_peak:.3g} % "
+        f"of its peak): over the last {len(recent)} increments λ stayed within {max(recent) - min(recent):.3g} "
+        f"and they dissipated {sum(recent_dG):.3g}, {100 * sum(recent_dG) / st.dissipated:.2g} % of the energy "
+        f"dissipated so far; the constrained iterations fail at every larger increment. The last converged "
+        f"state is kept. Where the path is expected to rise to the design load, load control "
+        f"(control = 'load') with [steps] stabilize passes such a state; else refine the mesh at the "
+        f"debonding front")
 
 
 def increment_length(problem: Problem, du: np.ndarray) -> float:
@@ -1260,7 +1287,7 @@ def ledger_booked(problem: Problem) -> tuple[float, float]:
 
 #: the refusal of a force path's dissipation-controlled increment that the interfaces booked as
 #: friction rather than damage (:data:`CONSTRAINT_BOOKED`)
-FRICTION_REFUSED = "the dissipation constraint was met by friction on unloading, not by damage"
+FRICTION_REFUSED = Reason.FRICTION_REFUSED  # (the message: FRICTION_REFUSED.message)
 #: such an increment is grown by GROW_FACTOR up to GROW_REFUSED times before it is cut
 GROW_FACTOR = 8.0
 GROW_REFUSED = 6
