@@ -936,6 +936,32 @@ def _reinforcement(ld: schema.LayerDef, i: int, laws: dict) -> tuple[Reinforceme
     return tuple(out)
 
 
+#: the longest side over the shortest of an element beyond which a concrete layer's crack band
+#: (13/18 √area) differs from the element's length along a crack normal by more than a factor √2
+BAND_ASPECT = 2.0
+
+
+def crack_band_notes(model: Model) -> list[str]:
+    """A note per concrete layer on elements elongated beyond :data:`BAND_ASPECT`: the crack band
+    there is not the element's length along the crack normal."""
+    notes = []
+    X = model.mesh.nodes[model.mesh.elements[:, :4]]
+    sides = np.linalg.norm(np.roll(X, -1, axis=1) - X, axis=2)
+    aspect = sides.max(axis=1) / np.maximum(sides.min(axis=1), 1e-300)
+    for k, ly in enumerate(model.layers):
+        if ly.law is None or not hasattr(ly.law, "f_ct"):
+            continue
+        el = np.flatnonzero([k in model.stacks[si] for si in model.element_stack])
+        bad = el[aspect[el] > BAND_ASPECT]
+        if bad.size:
+            notes.append(f"layer '{ly.name}': {bad.size} element(s) are elongated (sides up to {aspect[bad].max():.3g} "
+                         f"times as long as the shortest, element {bad[np.argmax(aspect[bad])]}); a concrete layer's "
+                         "crack band is 13/18 √(element area), so there a crack dissipates G_F times the band over the "
+                         "element's length along the crack normal instead of G_F: use elements whose sides differ "
+                         f"by at most a factor {BAND_ASPECT:g} where the concrete cracks")
+    return notes
+
+
 def _check_crack_band(model: Model) -> None:
     """The crack bands of every concrete layer stay below the snap-back limit of its softening
     (:meth:`layershell.laws.ConcreteLaw.check_band`), checked before the analysis."""
@@ -1265,6 +1291,6 @@ def build(mf: schema.ModelFile, base: Path = Path(".")) -> RunSpec:
     spec.lines = build_lines(mf, model, index)
     from .material_axes import material_axis_notes
 
-    spec.warnings = notes + material_axis_notes(model, mf.mesh.type)
+    spec.warnings = notes + material_axis_notes(model, mf.mesh.type) + crack_band_notes(model)
     spec.path_following = _path_settings(st, model)
     return spec
