@@ -12,11 +12,12 @@ import pytest
 from layershell.element.inelastic import initial_state, inelastic_block, inelastic_response, put_trial
 from layershell.element.kernel import layer_block, layer_response_reference
 from layershell.element.shape import NODE_XI
+from layershell.laws import PointState
 from layershell.material import Orthotropic
 
 
 @dataclass(frozen=True)
-class _Hist:
+class _Hist(PointState):
     emax: np.ndarray
 
 

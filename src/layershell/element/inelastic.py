@@ -112,16 +112,16 @@ class LayerState:
     sheet_stress: tuple = ()
 
     def copy(self) -> "LayerState":
-        return LayerState(_copy(self.bulk), tuple(_copy(s) for s in self.sheets),
+        return LayerState(None if self.bulk is None else self.bulk.copy(), tuple(s.copy() for s in self.sheets),
                           None if self.strain is None else self.strain.copy(),
                           tuple(a.copy() for a in self.sheet_strain), tuple(a.copy() for a in self.sheet_stress))
 
     def to_dict(self, prefix: str) -> dict[str, np.ndarray]:
         out: dict[str, np.ndarray] = {}
         if self.bulk is not None:
-            out.update(_arrays(self.bulk, f"{prefix}/bulk"))
+            out.update(self.bulk.to_dict(f"{prefix}/bulk/"))
         for k, s in enumerate(self.sheets):
-            out.update(_arrays(s, f"{prefix}/sheet{k}"))
+            out.update(s.to_dict(f"{prefix}/sheet{k}/"))
             out[f"{prefix}/sheet{k}.strain"] = self.sheet_strain[k]
             out[f"{prefix}/sheet{k}.stress"] = self.sheet_stress[k]
         if self.strain is not None:
@@ -129,8 +129,14 @@ class LayerState:
         return out
 
     def load(self, d: dict, prefix: str) -> "LayerState":
-        """The same state with the arrays of ``d`` (written by :meth:`to_dict`)."""
-        bulk = None if self.bulk is None else _from_arrays(self.bulk, d, f"{prefix}/bulk")
+        """The same state with the arrays of ``d`` (written by :meth:`to_dict`); KeyError where one is
+        missing or of another size."""
+
+        def state(like, key):
+            st = type(like).from_dict(d, key)
+            if st.n != like.n:
+                raise KeyError(key)
+            return st
 
         def arr(key, like):
             if key not in d or np.shape(d[key]) != np.shape(like):
@@ -138,43 +144,17 @@ class LayerState:
             return np.array(d[key], dtype=float)
 
         n = len(self.sheets)
-        return LayerState(bulk, tuple(_from_arrays(s, d, f"{prefix}/sheet{k}") for k, s in enumerate(self.sheets)),
+        return LayerState(None if self.bulk is None else state(self.bulk, f"{prefix}/bulk/"),
+                          tuple(state(s, f"{prefix}/sheet{k}/") for k, s in enumerate(self.sheets)),
                           None if self.strain is None else arr(f"{prefix}/strain", self.strain),
                           tuple(arr(f"{prefix}/sheet{k}.strain", self.sheet_strain[k]) for k in range(n)),
                           tuple(arr(f"{prefix}/sheet{k}.stress", self.sheet_stress[k]) for k in range(n)))
 
 
-def _fields(state) -> list[str]:
-    return [f.name for f in dataclasses.fields(state)]
-
-
-def _copy(state):
-    if state is None:
-        return None
-    return dataclasses.replace(state, **{k: np.array(getattr(state, k), copy=True) for k in _fields(state)})
-
-
-def _take(state, idx: slice):
-    return dataclasses.replace(state, **{k: getattr(state, k)[idx] for k in _fields(state)})
-
-
 def _put(dst, idx: slice, src) -> None:
-    for k in _fields(dst):
-        getattr(dst, k)[idx] = getattr(src, k)
-
-
-def _arrays(state, prefix: str) -> dict[str, np.ndarray]:
-    return {f"{prefix}/{k}": np.asarray(getattr(state, k)) for k in _fields(state)}
-
-
-def _from_arrays(like, d: dict, prefix: str):
-    vals = {}
-    for k in _fields(like):
-        key = f"{prefix}/{k}"
-        if key not in d or np.shape(d[key]) != np.shape(getattr(like, k)):
-            raise KeyError(key)
-        vals[k] = np.array(d[key], dtype=float)
-    return dataclasses.replace(like, **vals)
+    """Write the point state ``src`` into the points ``idx`` of ``dst`` (in place)."""
+    for f in dataclasses.fields(dst):
+        getattr(dst, f.name)[idx] = getattr(src, f.name)
 
 
 def initial_state(block: InelasticBlock) -> LayerState:
@@ -313,8 +293,8 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
         f, K = layer_response(block.base, U, nonlinear, tangent, sl)
     else:
         P = block.n_points
-        c = _take(committed.bulk, slice(lo * P, hi * P))
-        extra = {} if implex is None else {"implex": _take(implex.bulk, slice(lo * P, hi * P))}
+        c = committed.bulk.take(slice(lo * P, hi * P))
+        extra = {} if implex is None else {"implex": implex.bulk.take(slice(lo * P, hi * P))}
         out = {}
 
         def stress(E):
@@ -335,7 +315,7 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
     trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
-        fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, _take(committed.sheets[k], slice(lo * q, hi * q)),
+        fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, committed.sheets[k].take(slice(lo * q, hi * q)),
                                     fast)
         f = f + fs
         if tangent:
@@ -384,7 +364,7 @@ def point_stress(model, k: int, elements: np.ndarray, xi: np.ndarray, eta: np.nd
         j = iz * 9 + iq[inside] if not isinstance(blk.base, LayerBlock) else iq[inside] * nz + iz
         e = pos[inside]
         flat = e * blk.n_points + j
-        c = dataclasses.replace(st.bulk, **{f: getattr(st.bulk, f)[flat] for f in _fields(st.bulk)})
+        c = st.bulk.take(flat)
         S, _, _ = blk.law.response(E[inside], c, blk.h_in[e, j], blk.h_z[e, j], blk.normal[e, j], False)
         out[inside] = S
     return out
