@@ -613,9 +613,18 @@ class Assembler:
         f, data = self._values(u_full, tangent)
         if data is None:
             return f, None
+        return f, self._full_matrix(data)
+
+    def evaluate_both(self, u_full: np.ndarray, op):
+        """``(f_int, K, K_r)`` from one assembly: the full-space tangent and the reduced one
+        Tᵀ K T of constraint operator ``op`` (the tangent predictor of inelastic layers needs both)."""
+        f, data = self._values(u_full, True)
+        return f, self._full_matrix(data), self.reduced_scatter(op).matrix(data, symmetric=self.symmetric)
+
+    def _full_matrix(self, data: np.ndarray) -> sp.csr_matrix:
         K = sp.csr_matrix((data, self.indices, self.indptr), shape=(self.dm.n_full,) * 2)
         K.has_sorted_indices = True
-        return f, K
+        return K
 
     def evaluate_reduced(self, u_full: np.ndarray, op, forces: bool = True):
         """Return ``(f_int, K_r)``: the full-space internal force and the reduced tangent

@@ -207,6 +207,10 @@ class Model:
                     )
         return out
 
+    def layer_elements(self, k: int) -> np.ndarray:
+        """The elements whose stack carries layer ``k``."""
+        return np.flatnonzero([k in self.stacks[s] for s in self.element_stack])
+
     def layers_present(self) -> np.ndarray:
         """(n_layers, n_nodes): layer k exists at the node (an element of a stack with k touches it)."""
         on = np.zeros((len(self.layers), self.mesh.n_nodes), bool)

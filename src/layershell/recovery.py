@@ -531,7 +531,7 @@ class Recovery:
         E = model.mesh.elements
         self._geometry = {}
         for k in range(len(model.layers)):
-            els = np.flatnonzero([k in model.stacks[s] for s in model.element_stack])
+            els = model.layer_elements(k)
             at_edge = els[np.isin(E[els], self._edge).any(axis=1)]
             spn = surface_points(model.mesh.nodes[E[at_edge]], NODE_XI[:, 0], NODE_XI[:, 1]) if at_edge.size else None
             self._geometry[k] = (els, surface_points(model.mesh.nodes[E[els]], pts[:, 0], pts[:, 1]), at_edge, spn)

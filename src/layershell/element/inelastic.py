@@ -167,11 +167,20 @@ def initial_state(block: InelasticBlock) -> LayerState:
                       tuple(np.zeros(n) for n in nq), tuple(np.zeros(n) for n in nq))
 
 
-def _point_geometry(base, sp, Hq: np.ndarray, w2: np.ndarray):
+def in_plane_band(X: np.ndarray, sp=None) -> np.ndarray:
+    """The in-plane crack band of elements with nodes ``X (e, 9, 3)`` (or their surface points
+    ``sp`` at the 3 × 3 Gauss points): :data:`BAND_FRACTION` √(element area)."""
+    pts, w2 = gauss_2d(3)
+    if sp is None:
+        sp = surface_points(X, pts[:, 0], pts[:, 1])
+    return BAND_FRACTION * np.sqrt(np.sum(sp.sqrtA * w2, axis=1))
+
+
+def _point_geometry(base, sp, Hq: np.ndarray):
     """h_in, h_z, normal at the base block's points (LayerBlock q-major, MITC9 z-major)."""
     e, q = Hq.shape
     nz = base.dV.shape[1] // q
-    h_in = BAND_FRACTION * np.sqrt(np.sum(sp.sqrtA * w2, axis=1))  # of √(element area)
+    h_in = in_plane_band(None, sp)
     hz = Hq / nz
     if isinstance(base, LayerBlock):  # point = iq · nz + iz
         normal = np.repeat(sp.A3, nz, axis=1)
@@ -205,7 +214,7 @@ def inelastic_block(X, H_below, H, d: int, material, law, sheets=(), n_thickness
                        keep_map=law is not None)
     pts, w2 = gauss_2d(3)
     sp = surface_points(X, pts[:, 0], pts[:, 1])
-    h_in, h_z, normal = _point_geometry(base, sp, sp.interpolate(H), w2)
+    h_in, h_z, normal = _point_geometry(base, sp, sp.interpolate(H))
     made = tuple(sheet_block(X, H_below, H, d, h, A, lw, nm, ang, dr) for nm, lw, h, A, ang, dr in sheets)
     return InelasticBlock(base, law, h_in, h_z, normal, made)
 

@@ -951,7 +951,7 @@ def crack_band_notes(model: Model) -> list[str]:
     for k, ly in enumerate(model.layers):
         if ly.law is None or not hasattr(ly.law, "f_ct"):
             continue
-        el = np.flatnonzero([k in model.stacks[si] for si in model.element_stack])
+        el = model.layer_elements(k)
         bad = el[aspect[el] > BAND_ASPECT]
         if bad.size:
             notes.append(f"layer '{ly.name}': {bad.size} element(s) are elongated (sides up to {aspect[bad].max():.3g} "
@@ -965,18 +965,14 @@ def crack_band_notes(model: Model) -> list[str]:
 def _check_crack_band(model: Model) -> None:
     """The crack bands of every concrete layer stay below the snap-back limit of its softening
     (:meth:`layershell.laws.ConcreteLaw.check_band`), checked before the analysis."""
-    from ..element.geometry import surface_points
-    from ..element.inelastic import BAND_FRACTION
-    from ..element.quadrature import gauss_2d
+    from ..element.inelastic import in_plane_band
 
-    pts, w2 = gauss_2d(3)
     for k, ly in enumerate(model.layers):
         if ly.law is None or not hasattr(ly.law, "check_band"):
             continue
-        el = np.flatnonzero([k in model.stacks[si] for si in model.element_stack])
+        el = model.layer_elements(k)
         conn = model.mesh.elements[el]
-        sp = surface_points(model.mesh.nodes[conn], pts[:, 0], pts[:, 1])
-        h_in = BAND_FRACTION * np.sqrt(np.sum(sp.sqrtA * w2, axis=1))
+        h_in = in_plane_band(model.mesh.nodes[conn])
         nz = max(model.n_thickness, ly.directors + (1 if model.element == "mitc" else 0))
         h_z = ly.thickness[conn].max(axis=1) / nz
         try:

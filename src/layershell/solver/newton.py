@@ -248,7 +248,7 @@ def sets_violation(blocks: list, u: np.ndarray, measured: bool = True) -> float:
 #: (a tension bar: 17 % too much energy with 1/600 of the path per increment, the fully localised
 #: crack's with increments cut to this bound; tests/test_concrete_layer.py)
 IMPLEX_TOLERANCE = 0.05
-#: cuts of an increment for IMPL-EX's tolerance before its error is accepted (and recorded): at
+#: cuts of an increment for IMPL-EX's tolerance before its error is accepted: at
 #: a jump of the path (a crack band that must open at once: a local snap-back) no increment is
 #: short enough
 IMPLEX_CUTS = 5
@@ -266,17 +266,12 @@ def implex_checked(problem: Problem, u_new_res: tuple[np.ndarray, NewtonResult],
                    cuts: int = 0) -> tuple[np.ndarray, NewtonResult]:
     """A converged increment whose IMPL-EX damage error exceeds :data:`IMPLEX_TOLERANCE` is
     reported as not converged, so that the caller cuts it, unless it has been cut
-    :data:`IMPLEX_CUTS` times (``cuts``) already: then it is accepted and its error recorded
-    (``problem.implex_accepted``)."""
+    :data:`IMPLEX_CUTS` times (``cuts``) already: then it is accepted."""
     u_new, res = u_new_res
     asm = getattr(problem, "assembler", None)
-    if res.converged and getattr(asm, "extrapolated", None):
+    if res.converged and cuts < IMPLEX_CUTS and getattr(asm, "extrapolated", None):
         err = asm.implex_error(u_new)
-        if err > IMPLEX_TOLERANCE and cuts >= IMPLEX_CUTS:
-            acc = getattr(problem, "implex_accepted", None)
-            if acc is not None:
-                acc.append(err)
-        elif err > IMPLEX_TOLERANCE:
+        if err > IMPLEX_TOLERANCE:
             return u_new, NewtonResult(False, res.iterations, res.residuals,
                                        f"the increment changes the damage by {err:.3g} beyond its extrapolation "
                                        f"(IMPL-EX, at most {IMPLEX_TOLERANCE:g})")
@@ -291,8 +286,7 @@ def tangent_predictor(problem: Problem, u: np.ndarray, lam: float, s: NewtonSett
     (cracking concrete) would see a trial state far off the path."""
     op = problem.op
     u_new = problem.impose(u, lam)
-    f, K = problem.assembler.evaluate(u)
-    _, Kr = problem.assembler.evaluate_reduced(u, op, forces=False)
+    f, K, Kr = problem.assembler.evaluate_both(u, op)
     r = op.reduce(problem.external(lam) - f - K @ (u_new - u))
     try:
         du = problem.solve_tangent(Kr, r, s.backend, s.reuse_factorization)

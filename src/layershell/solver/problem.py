@@ -47,8 +47,6 @@ class Problem:
     # the damping term of a pseudo-transient relaxation (solver/newton.py PseudoViscosity), added
     # to every residual and tangent while set; None: the static problem
     pseudo: object = field(default=None, repr=False)
-    # IMPL-EX increments accepted beyond their damage tolerance after IMPLEX_CUTS cuts: their errors
-    implex_accepted: list = field(default_factory=list, repr=False)
 
     @classmethod
     def build(cls, model: Model) -> "Problem":
@@ -131,7 +129,7 @@ class Problem:
                 out[k] = out.get(k, 0) + v
         return out
 
-    def commit(self, u: np.ndarray, lam: float | None = None) -> None:  # noqa: D401
+    def commit(self, u: np.ndarray, lam: float | None = None) -> None:
         """Take the material state of the inelastic layers at the converged ``u`` (load factor
         ``lam``) as committed (nothing without inelastic layers)."""
         self.assembler.commit(u, lam)
