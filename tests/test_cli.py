@@ -357,3 +357,16 @@ def test_a_run_stopped_after_its_peak_names_the_peak_instead_of_the_support_hint
     assert _post_peak_cause(summary([100.0, 327.12, 327.12 * (1 - 0.5 * POST_PEAK)])) is None  # at the peak
     assert _post_peak_cause(summary([])) is None and _post_peak_cause({}) is None
     assert _post_peak_cause(summary([0.0, -1.0])) is None  # no positive peak
+
+
+def test_help_texts_keep_model_file_section_names():
+    """Section names in square brackets reach the help text as written (no markup eats them)."""
+    from typer.testing import CliRunner
+
+    from layershell.cli import app
+
+    res = CliRunner().invoke(app, ["buckle", "--help"], env={"NO_COLOR": "1", "COLUMNS": "200"})
+    assert res.exit_code == 0
+    text = " ".join(res.stdout.split())
+    assert "initially debonded zones of [[interfaces]]" in text
+    assert "buckling_modes.npz (for [imperfection])" in text
