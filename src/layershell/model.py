@@ -27,7 +27,8 @@ class Reinforcement:
     """A reinforcement sheet inside a layer (rebar, textile): a uniaxial ``law``
     (:mod:`layershell.laws.uniaxial`) at ``height`` above the layer's bottom face, with the area
     ``area`` per unit width along the tangent-plane projection of ``direction`` (None: the first
-    coordinate line) turned by ``angle`` degrees about the normal (:mod:`layershell.element.inelastic`)."""
+    coordinate line) turned by ``angle`` degrees about the normal (:mod:`layershell.element.inelastic`);
+    ``bar_diameter`` where the sheet was given as bars (for the crack spacing)."""
 
     name: str
     law: object
@@ -35,6 +36,7 @@ class Reinforcement:
     area: float
     angle: float = 0.0
     direction: tuple[float, float, float] | None = None
+    bar_diameter: float | None = None
 
 
 @dataclass(frozen=True)
