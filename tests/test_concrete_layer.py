@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pytest
@@ -159,7 +160,14 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('grade = "B500B"', 'grade = "S235"'), "materials.b500", "B500"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "refine the mesh"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = -0.1'), "materials.c30.G_F", "greater than 0"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.0'), "materials.c30.G_F",
+     "tensile fracture energy (force/length)"),
     (('bar_diameter = 10.0, spacing = 200.0', 'area = 0.0'), "reinforcement[0].area", "greater than 0"),
+    (('bar_diameter = 10.0, spacing = 200.0', 'area = -1.0'), "reinforcement[0].area", "or give bar_diameter"),
+    (('bar_diameter = 10.0', 'bar_diameter = -10.0'), "reinforcement[0].bar_diameter", "greater than 0"),
+    (('strength_class = "C30/37"', 'f_c = 38.0'), "materials.c30", "missing: E, f_ct, G_F, G_c, eps_c1"),
+    (('height = 30.0', 'height = 160.0'), "reinforcement[0].height", "160 thick"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "units"),
 ])
 def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
     text = strip_model(6, 4)
@@ -168,6 +176,18 @@ def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
         build(parse(text.replace(*edit)))
     msg = str(err.value)
     assert field in msg and fix in msg, msg
+
+
+def test_crack_band_limit_names_the_largest_element():
+    """A G_F that puts the snap-back limit 2 G_F E / f_ct² below the band of 250 mm elements: the
+    error names the largest element size that passes (between the 250 mm that fail and the
+    167 mm of the next mesh with a node row at the load), and that mesh builds."""
+    gf = 'strength_class = "C30/37"\nG_F = 0.02'
+    with pytest.raises(InputError, match="snap-back limit") as err:
+        build(parse(strip_model(6, 4).replace('strength_class = "C30/37"', gf)))
+    size = float(re.search(r"elements up to ([0-9.]+) across", str(err.value)).group(1))
+    assert 1500.0 / 9 < size < 1500.0 / 6
+    build(parse(strip_model(9, 4).replace('strength_class = "C30/37"', gf)))
 
 
 def test_crack_width_probe_needs_a_concrete_layer():
