@@ -39,12 +39,17 @@ def full_strains(g, U, nonlinear, E):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
+def full_terms(g, dV, S, D, U, nonlinear, want_k, want_geo, f, W, GS, GT):  # pragma: no cover
     """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
-    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
-    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3).
-    As in ``_jit.point_terms``: B_W,(a i) = Σ_K g_aK Φ_WKi with Φ_WKi = Σ_J F_iJ [Voigt(J, K) = W]
-    and (D dV B)_W,(a i) = Σ_K g_aK Ψ_WKi with Ψ_WKi = Σ_J F_iJ (D dV)_W,Voigt(J, K)."""
+    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the operands W (e, 3, 3, q, 3, a) of the
+    material stiffness in gradient form, K_(a i)(b k) = Σ_(q, K) g_aK W[i, k, q, K, b], and the
+    geometric operands GS = g S dV, GT = g (e, a, q, 3).
+
+    As in ``_jit.point_terms``: B_V,(a i) = Σ_K g_aK Φ_VKi with Φ_VKi = Σ_J F_iJ [Voigt(J, K) = V]
+    and (D dV B)_V,(b k) = Σ_L g_bL Ψ_VLk with Ψ_VLk = Σ_J F_kJ (D dV)_V,Voigt(J, L), so that
+    Bᵀ D B dV = Σ_(K, L) g_aK A_iKkL g_bL with the 9 × 9 A_iKkL = Σ_V Φ_VKi Ψ_VLk, and
+    W[i, k, q, K, b] = Σ_L A_iKkL g_bL: 9 products of a × 3q by 3q × a per element, half the
+    work of Bᵀ (D B) over the 6q Voigt rows."""
     ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
     H = np.empty((3, 3))
     F = np.empty((3, 3))
@@ -52,6 +57,7 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
     P = np.empty((3, 3))
     Phi = np.empty((6, 3, 3))
     Psi = np.empty((6, 3, 3))
+    A = np.empty((3, 3, 3, 3))
     for e in range(ne):
         for a in range(na):
             for i in range(3):
@@ -81,24 +87,32 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
                 g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
                 for i in range(3):
                     f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
-            if want_x:
-                for W in range(6):
+            if want_k:
+                for V in range(6):
                     for K in range(3):
                         for i in range(3):
-                            Phi[W, K, i] = 0.0
+                            Phi[V, K, i] = 0.0
                             s = 0.0
                             for J in range(3):
-                                V = _VMAP[J, K]
-                                s += F[i, J] * D[e, q, W, V]
-                                if V == W:
-                                    Phi[W, K, i] += F[i, J]
-                            Psi[W, K, i] = s * w
-                for W in range(6):
-                    for a in range(na):
-                        g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
-                        for i in range(3):
-                            X[e, q, W, a, i] = g0 * Phi[W, 0, i] + g1 * Phi[W, 1, i] + g2 * Phi[W, 2, i]
-                            Y[e, q, W, a, i] = g0 * Psi[W, 0, i] + g1 * Psi[W, 1, i] + g2 * Psi[W, 2, i]
+                                X = _VMAP[J, K]
+                                s += F[i, J] * D[e, q, V, X]
+                                if X == V:
+                                    Phi[V, K, i] += F[i, J]
+                            Psi[V, K, i] = s * w
+                for i in range(3):
+                    for K in range(3):
+                        for k in range(3):
+                            for L in range(3):
+                                s = 0.0
+                                for V in range(6):
+                                    s += Phi[V, K, i] * Psi[V, L, k]
+                                A[i, K, k, L] = s
+                for i in range(3):
+                    for k in range(3):
+                        for K in range(3):
+                            a0, a1, a2 = A[i, K, k, 0], A[i, K, k, 1], A[i, K, k, 2]
+                            for b in range(na):
+                                W[e, i, k, q, K, b] = a0 * g[e, q, b, 0] + a1 * g[e, q, b, 1] + a2 * g[e, q, b, 2]
             if want_geo:
                 for a in range(na):
                     g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
