@@ -162,11 +162,11 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
     C0 = np.empty((6, 6))
     R = np.empty((6, nT))
     L = np.empty((nT, 6))
-    Cl = np.empty((nT, nT))
-    sl = np.empty(nT)
     for e in range(ne):
         for z in range(nz):
+            sl = sig[e, z]  # the level's tie stresses and tied stiffness, summed in place
             sl[:] = 0.0
+            Cl = Ch[e, z] if tangent else Ch[0, 0]
             if tangent:
                 Cl[:] = 0.0
             for q in range(9):
@@ -200,13 +200,6 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
                     for j2 in range(qn[q]):
                         Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
             _correct(v[e, z], comp, tangent, sl, Cl, S0, R, L, C0)
-            for k in range(nT):
-                sig[e, z, k] = sl[k]
-            if not tangent:
-                continue
-            for k in range(nT):
-                for l in range(nT):
-                    Ch[e, z, k, l] = Cl[k, l]
 
 
 @njit(cache=True, nogil=True, fastmath=True)

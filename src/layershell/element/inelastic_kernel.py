@@ -172,7 +172,7 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
             t = min(s + _SUB, r1)
             nb = t - s
             sig = np.empty((nb, nz, nT))
-            Ch = np.empty((nb, nz, nT, nT)) if tangent else _NONE4
+            Ch = np.empty((nb, nz, nT, nT) if tangent else (1, 1, nT, nT))  # (1, 1, ...): the unused level
             jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], *nzw, v[s:t], tangent, sig, Ch)
             B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
             GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))

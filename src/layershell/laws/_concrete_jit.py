@@ -105,3 +105,57 @@ def split_tangent(V, w, P, d_t, d_c, rank2, g_t, g_c, e_t, sbar, lam, mu, out): 
                 out[n, a, d] = tr + 2.0 * mu * M[a, d]
             for d in range(3, 6):
                 out[n, a, d] = mu * M[a, d]
+
+
+@njit(cache=True, nogil=True)
+def damage_compression1(r, h, E, f_c, eps_c1, G_c):  # pragma: no cover
+    """d⁻(r; h) and ∂d⁻/∂r of one point: ``ConcreteLaw.damage_compression`` (Sargin secant to the
+    peak E ε_c1, exponential beyond)."""
+    rp, k = E * eps_c1, E * eps_c1 / f_c
+    eta = min(max(r / rp, 0.0), 1.0)
+    den = 1.0 + (k - 2.0) * eta
+    if not r > rp:
+        return 1.0 - (k - eta) / (k * den), (k - 1.0) ** 2 / (k * den * den) / rp
+    inv_es = (h if h > 0 else 1.0) * f_c / G_c
+    sig = f_c * np.exp(-(r / E - eps_c1) * inv_es)
+    keep = sig / r
+    return 1.0 - keep, sig / r ** 2 + keep * inv_es / E
+
+
+@njit(cache=True, nogil=True)
+def histories(w, r_c0, r_t0, h_c, E, f_c, eps_c1, G_c, alpha, kappa,
+              r_c, d_c, ddc, r_t, load_t, dtau_t):  # pragma: no cover
+    """Per point from the effective principal stresses ``w`` (n, 3) ascending and the committed
+    histories ``r_c0``, ``r_t0``: the compression's τ⁻ = (α Ī1⁻ + √(3 J̄2⁻))/(1 − α), history r_c,
+    damage d_c and dd⁻/dw (``ddc``); the tension's τ⁺ = ⟨w_3⟩/(1 − κ q⁻/f_c) with q⁻ = (1 − d⁻) τ⁻,
+    its history r_t, whether it loads (``load_t``) and dτ⁺/dw (``dtau_t``)
+    (``ConcreteLaw._compression`` and the tension part of ``ConcreteLaw._update``)."""
+    dev = np.empty(3)
+    dtau = np.empty(3)
+    for n in range(w.shape[0]):
+        m0, m1, m2 = min(w[n, 0], 0.0), min(w[n, 1], 0.0), min(w[n, 2], 0.0)
+        i1 = m0 + m1 + m2
+        dev[0], dev[1], dev[2] = m0 - i1 / 3.0, m1 - i1 / 3.0, m2 - i1 / 3.0
+        s3j2 = np.sqrt(1.5 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]))
+        tau = (alpha * i1 + s3j2) / (1 - alpha)
+        for k in range(3):
+            dk = (alpha + (1.5 * dev[k] / s3j2 if s3j2 > 0 else 0.0)) / (1 - alpha)
+            dtau[k] = dk if w[n, k] < 0 else 0.0
+        load = tau > r_c0[n]
+        r = tau if load else r_c0[n]
+        d, dd = damage_compression1(r, h_c[n], E, f_c, eps_c1, G_c)
+        r_c[n], d_c[n] = r, d
+        tp = max(tau, 0.0)
+        q = (1.0 - d) * tp
+        rho = 1.0 - kappa * q / f_c
+        pos = w[n, 2] > 0
+        tau_t = (w[n, 2] if pos else 0.0) / rho
+        ft = tau_t * kappa / (f_c * rho)
+        for k in range(3):
+            ddc[n, k] = (dd if load else 0.0) * dtau[k]
+            dq = ((1.0 - d) if tau > 0 else 0.0) * dtau[k] - tp * ddc[n, k]
+            dtau_t[n, k] = ft * dq
+        if pos:
+            dtau_t[n, 2] += 1.0 / rho
+        load_t[n] = tau_t > r_t0[n]
+        r_t[n] = tau_t if load_t[n] else r_t0[n]

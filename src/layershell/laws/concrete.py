@@ -201,23 +201,19 @@ class ConcreteLaw:
         return 1.0 - np.where(post, keep_post, keep_pre), np.where(post, dpost, dpre)
 
     # -- response -------------------------------------------------------------------------------
-    def _compression(self, w, committed, h_c):
-        """τ⁻, r⁻, d⁻, the nominal equivalent q⁻ and the derivatives dd⁻/dw, dq⁻/dw (n, 3)."""
-        a = (self.k_b - 1.0) / (2.0 * self.k_b - 1.0)
-        m = np.minimum(w, 0.0)
-        i1 = m.sum(1)
-        dev = m - i1[:, None] / 3.0
-        s3j2 = np.sqrt(1.5 * np.sum(dev * dev, 1))
-        tau = (a * i1 + s3j2) / (1 - a)
-        dtau = (a + 1.5 * dev / np.where(s3j2 > 0, s3j2, 1.0)[:, None] * (s3j2 > 0)[:, None]) / (1 - a)
-        dtau = dtau * (w < 0)
-        load = tau > committed.r_c
-        r = np.where(load, tau, committed.r_c)
-        d, dd = self.damage_compression(r, h_c)
-        ddw = (dd * load)[:, None] * dtau
-        q = (1.0 - d) * np.maximum(tau, 0.0)
-        dq = ((1.0 - d) * (tau > 0))[:, None] * dtau - np.maximum(tau, 0.0)[:, None] * ddw
-        return r, d, ddw, q, dq
+    def _histories(self, w, committed, h_c):
+        """Per point from the effective principal stresses ``w``: r⁻, d⁻ and dd⁻/dw (n, 3) of the
+        compression, r⁺, whether it loads and dτ⁺/dw (n, 3) of the tension (module docstring: τ⁻,
+        τ⁺ = ⟨σ̄_max⟩/(1 − κ q⁻/f_c)); compiled, :func:`layershell.laws._concrete_jit.histories`."""
+        from ._concrete_jit import histories
+
+        n = w.shape[0]
+        r_c, d_c, r_t = np.empty(n), np.empty(n), np.empty(n)
+        ddc, dtau_t, load_t = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+        f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+        histories(f64(w), f64(committed.r_c), f64(committed.r_t), f64(h_c), self.E, self.f_c, self.eps_c1, self.G_c,
+                  (self.k_b - 1.0) / (2.0 * self.k_b - 1.0), KAPPA_TC, r_c, d_c, ddc, r_t, load_t, dtau_t)
+        return r_c, d_c, ddc, r_t, load_t, dtau_t
 
     def _band(self, V, w, normal, h_in, h_z):
         """Crack band from the principal direction of σ̄_max, and the row r with r @ dσ̄ = dh."""
@@ -263,15 +259,7 @@ class ConcreteLaw:
                              "spacing) must be positive at every point; pass the element's sizes")
         sbar = eps @ self.stiffness()
         w, V, P = spectral.principal(sbar)
-        r_c, d_c, ddc, q, dq = self._compression(w, committed, h_in)
-
-        pos = w[:, 2] > 0
-        rho = 1.0 - KAPPA_TC * q / self.f_c
-        tau_t = np.where(pos, w[:, 2], 0.0) / rho
-        dtau_t = (tau_t * KAPPA_TC / (self.f_c * rho))[:, None] * dq
-        dtau_t[:, 2] += pos / rho
-        load_t = tau_t > committed.r_t
-        r_t = np.where(load_t, tau_t, committed.r_t)
+        r_c, d_c, ddc, r_t, load_t, dtau_t = self._histories(w, committed, h_in)
         onset = (committed.h_t <= 0) & (r_t > self.f_ct)
         on = np.flatnonzero(onset)
         h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], h_in[on], h_z[on])
