@@ -17,6 +17,7 @@ from helpers import example_spec, stopped_and_restarted
 from layershell.analytic.rc_section import (Concrete, RCSection, Rebar, cracking_moment, transformed_uncracked,
                                            ultimate_moment, yield_moment)
 from layershell.element.inelastic import BAND_FRACTION
+from layershell.export import material_cell_fields
 from layershell.io.build import build, parse
 from layershell.io.errors import InputError
 from layershell.laws import ConcreteLaw, SteelLaw
@@ -255,6 +256,9 @@ def test_strip_cracks_then_yields_and_restarts_exactly(tmp_path):
     assert sig[0] < 0.1 * B500.f_y and B500.f_y <= sig[-1] < B500.f_y + B500.E_h * 0.05
     dis = np.array([r["dissipated_material"] for r in res.summary["steps"]])
     assert np.all(np.diff(dis) >= -1e-9) and dis[-1] > 0
+    cells = material_cell_fields(res.problem.model)  # the surface files' bar state: 1 where yielded
+    state, stress = cells["rebar_state_slab_b500_1"], cells["rebar_stress_slab_b500_1"]
+    assert state.max() == 1 and np.array_equal(state == 1, stress >= B500.f_y * (1 - 1e-9))
     part, again = stopped_and_restarted(spec, tmp_path / "part", 12)
     assert part.interrupted and again.converged
     assert np.allclose(again.u, res.u, rtol=0, atol=1e-9 * np.abs(res.u).max())

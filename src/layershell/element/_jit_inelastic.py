@@ -99,26 +99,33 @@ def full_terms(g, dV, S, D, U, nonlinear, want_k, want_geo, f, W, GS, GT):  # pr
                                 if X == V:
                                     Phi[V, K, i] += F[i, J]
                             Psi[V, K, i] = s * w
-                for i in range(3):
-                    for K in range(3):
-                        for k in range(3):
-                            for L in range(3):
-                                s = 0.0
-                                for V in range(6):
-                                    s += Phi[V, K, i] * Psi[V, L, k]
-                                A[i, K, k, L] = s
-                for i in range(3):
-                    for k in range(3):
-                        for K in range(3):
-                            a0, a1, a2 = A[i, K, k, 0], A[i, K, k, 1], A[i, K, k, 2]
-                            for b in range(na):
-                                W[e, i, k, q, K, b] = a0 * g[e, q, b, 0] + a1 * g[e, q, b, 1] + a2 * g[e, q, b, 2]
+                _gradient_form(Phi, Psi, g[e, q], A, W[e], q)
             if want_geo:
                 for a in range(na):
                     g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
                     for K in range(3):
                         GS[e, a, q, K] = g0 * Sm[0, K] + g1 * Sm[1, K] + g2 * Sm[2, K]
                         GT[e, a, q, K] = g[e, q, a, K]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _gradient_form(Phi, Psi, gq, A, We, q):  # pragma: no cover
+    """One point's share of :func:`full_terms`' W: A_iKkL = Σ_V Φ_VKi Ψ_VLk (into ``A``), then
+    W[i, k, q, K, b] = Σ_L A_iKkL g_bL with the point's gradients ``gq`` (a, 3)."""
+    for i in range(3):
+        for K in range(3):
+            for k in range(3):
+                for L in range(3):
+                    s = 0.0
+                    for V in range(6):
+                        s += Phi[V, K, i] * Psi[V, L, k]
+                    A[i, K, k, L] = s
+    for i in range(3):
+        for k in range(3):
+            for K in range(3):
+                a0, a1, a2 = A[i, K, k, 0], A[i, K, k, 1], A[i, K, k, 2]
+                for b in range(gq.shape[0]):
+                    We[i, k, q, K, b] = a0 * gq[b, 0] + a1 * gq[b, 1] + a2 * gq[b, 2]
 
 
 @njit(cache=True, nogil=True, fastmath=True)
