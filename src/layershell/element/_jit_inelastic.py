@@ -242,3 +242,72 @@ def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
         for l in range(nT):
             vl, cl = v[l], comp[l]
             Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def sheet_strain(g, a, U, nonlinear, ga, Fa, eps):  # pragma: no cover
+    """A reinforcement sheet's strain along its direction a (e, q, 3) at its points,
+    ε = (∇u a)·a (+ ½ |∇u a|² with ``nonlinear``), from the basis gradients g (e, q, n, 3) and the
+    nodal vectors U (e, n, 3); also g_b·a (``ga`` (e, q, n)) and F a (``Fa`` (e, q, 3); a itself
+    when linear)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    for e in range(ne):
+        for q in range(nq):
+            a0, a1, a2 = a[e, q, 0], a[e, q, 1], a[e, q, 2]
+            h0 = h1 = h2 = 0.0
+            for b in range(na):
+                x = g[e, q, b, 0] * a0 + g[e, q, b, 1] * a1 + g[e, q, b, 2] * a2
+                ga[e, q, b] = x
+                h0 += x * U[e, b, 0]
+                h1 += x * U[e, b, 1]
+                h2 += x * U[e, b, 2]
+            s = h0 * a0 + h1 * a1 + h2 * a2
+            if nonlinear:
+                s += 0.5 * (h0 * h0 + h1 * h1 + h2 * h2)
+                Fa[e, q, 0], Fa[e, q, 1], Fa[e, q, 2] = a0 + h0, a1 + h1, a2 + h2
+            else:
+                Fa[e, q, 0], Fa[e, q, 1], Fa[e, q, 2] = a0, a1, a2
+            eps[e, q] = s
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def sheet_add(ga, Fa, sw, cw, nonlinear, tangent, f, K):  # pragma: no cover
+    """Add a sheet's forces f_(b i) += Σ_q s_q (g_b·a)(F a)_i and, with ``tangent``, its stiffness
+    K_(b i)(c k) += Σ_q [c_q (g_b·a)(F a)_i (g_c·a)(F a)_k + δ_ik s_q (g_b·a)(g_c·a)] (the
+    second term with ``nonlinear``) to ``f`` (e, 3n) and ``K`` (e, 3n, 3n); s = σ A_s dA
+    (``sw``), c = E_t A_s dA (``cw``), both (e, q). Each row of K is summed over the points first
+    and added once (one pass over K per element)."""
+    ne, nq, na = ga.shape[0], ga.shape[1], ga.shape[2]
+    m = 3 * na
+    R = np.empty((nq, m))
+    CR = np.empty((nq, m))
+    row = np.empty(m)
+    for e in range(ne):
+        for q in range(nq):
+            s = sw[e, q]
+            c = cw[e, q] if tangent else 0.0
+            for b in range(na):
+                for i in range(3):
+                    x = ga[e, q, b] * Fa[e, q, i]
+                    R[q, 3 * b + i] = x
+                    CR[q, 3 * b + i] = c * x
+                    f[e, 3 * b + i] += s * x
+        if not tangent:
+            continue
+        for r in range(m):
+            for t in range(m):
+                row[t] = 0.0
+            for q in range(nq):
+                cr = CR[q, r]
+                for t in range(m):
+                    row[t] += cr * R[q, t]
+            for t in range(m):
+                K[e, r, t] += row[t]
+        if nonlinear:
+            for b in range(na):
+                for d in range(na):
+                    x = 0.0
+                    for q in range(nq):
+                        x += sw[e, q] * ga[e, q, b] * ga[e, q, d]
+                    for i in range(3):
+                        K[e, 3 * b + i, 3 * d + i] += x
