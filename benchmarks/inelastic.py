@@ -11,6 +11,9 @@ and crushing, from a committed state with some damage (the state of 0.7 times th
 * ``cracked``: the share of the points with a crack in the committed state;
 * ``elastic s``: :func:`layershell.element.kernel.layer_response` of the layer's elastic block;
 * ``inelastic s``: :func:`layershell.element.inelastic.inelastic_response` (compiled point work);
+* ``IMPL-EX s``: the same with the histories extrapolated from the virgin to the committed state
+  (``implex``, the default integration of runs): the implicit update and the frozen-damage
+  response;
 * ``plain s``: the same through the kernels' plain NumPy forms (``fast=False``, the check);
 * ``law s``: ``ConcreteLaw.response`` alone at the same points (its share of ``inelastic s``);
 * ``with bars s``: the same concrete layer with two steel bar sheets (x and y, Ø12 at 200 mm,
@@ -29,7 +32,8 @@ import time
 
 import numpy as np
 
-from layershell.element.inelastic import initial_state, inelastic_block, inelastic_response, put_trial
+from layershell.element.inelastic import (extrapolated_state, initial_state, inelastic_block, inelastic_response,
+                                          put_trial)
 from layershell.element.kernel import kernel_threads, layer_response
 from layershell.laws import ConcreteLaw, SteelLaw
 from layershell.material import Orthotropic
@@ -66,10 +70,12 @@ def case(X, d: int, element: str, nz: int, law, chunk: int, repeat: int, referen
         sl = slice(s, min(s + chunk, ne))
         put_trial(committed, blk, sl, inelastic_response(blk, 0.7 * U[sl], True, False, sl, c0)[2])
 
-    def run(fast=True, b=blk, c=committed):
+    ex = extrapolated_state(blk, c0, committed, 1.0)
+
+    def run(fast=True, b=blk, c=committed, implex=None):
         for s in range(0, ne, chunk):
             sl = slice(s, min(s + chunk, ne))
-            inelastic_response(b, U[sl], True, True, sl, c, fast=fast)
+            inelastic_response(b, U[sl], True, True, sl, c, implex, fast=fast)
 
     c_rc = initial_state(rc)
     c_rc.bulk, c_rc.strain = committed.bulk, committed.strain  # the bulk's damage, virgin bars
@@ -90,10 +96,11 @@ def case(X, d: int, element: str, nz: int, law, chunk: int, repeat: int, referen
             law.response(strain[p], _slice_state(committed.bulk, p), hin[p], hz[p], nrm[p], True)
 
     run(), run_elastic(), run_law(), run(b=rc, c=c_rc)
-    t = {"elastic": [], "inelastic": [], "plain": [], "law": [], "rc": []}
+    t = {"elastic": [], "inelastic": [], "implex": [], "plain": [], "law": [], "rc": []}
     for _ in range(repeat):
         t["elastic"].append(_timed(run_elastic))
         t["inelastic"].append(_timed(run))
+        t["implex"].append(_timed(lambda: run(implex=ex)))
         t["rc"].append(_timed(lambda: run(b=rc, c=c_rc)))
         t["law"].append(_timed(run_law))
         if reference:  # BLAS single-threaded as in the compiled path (threaded BLAS on its small products
@@ -126,7 +133,8 @@ def main(argv=None) -> None:
     law = ConcreteLaw.from_class(30.0, length_unit=1e-3)
     print(f"elements={len(X)} chunk={a.chunk} repeat={a.repeat} threads={kernel_threads()} "
           f"load_average={os.getloadavg()[0]:.2f}")
-    head = "| d | element | points | cracked | elastic s | inelastic s | ratio | law s (share) | with bars s (ratio) |"
+    head = ("| d | element | points | cracked | elastic s | inelastic s | ratio | IMPL-EX s (ratio) | law s (share) | "
+            "with bars s (ratio) |")
     if not a.no_reference:
         head += " plain s | plain ratio |"
     print(head)
@@ -137,6 +145,7 @@ def main(argv=None) -> None:
                 r = case(X, d, element, nz, law, a.chunk, a.repeat, not a.no_reference)
                 row = (f"| {r['d']} | {r['element']} | {r['points']} | {r['cracked']:.2f} | {r['elastic']:.3f} | "
                        f"{r['inelastic']:.3f} | {r['inelastic'] / r['elastic']:.2f} | "
+                       f"{r['implex']:.3f} ({r['implex'] / r['elastic']:.2f}) | "
                        f"{r['law']:.3f} ({r['law'] / r['inelastic']:.2f}) | {r['rc']:.3f} ({r['rc'] / r['elastic']:.2f}) |")
                 if "plain" in r:
                     row += f" {r['plain']:.3f} | {r['plain'] / r['elastic']:.2f} |"

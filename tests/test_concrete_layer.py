@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import re
 
 import numpy as np
 import pytest
@@ -16,6 +17,7 @@ from helpers import example_spec, stopped_and_restarted
 from layershell.analytic.rc_section import (Concrete, RCSection, Rebar, cracking_moment, transformed_uncracked,
                                            ultimate_moment, yield_moment)
 from layershell.element.inelastic import BAND_FRACTION
+from layershell.export import material_cell_fields
 from layershell.io.build import build, parse
 from layershell.io.errors import InputError
 from layershell.laws import ConcreteLaw, SteelLaw
@@ -159,7 +161,14 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('grade = "B500B"', 'grade = "S235"'), "materials.b500", "B500"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "refine the mesh"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = -0.1'), "materials.c30.G_F", "greater than 0"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.0'), "materials.c30.G_F",
+     "tensile fracture energy (force/length)"),
     (('bar_diameter = 10.0, spacing = 200.0', 'area = 0.0'), "reinforcement[0].area", "greater than 0"),
+    (('bar_diameter = 10.0, spacing = 200.0', 'area = -1.0'), "reinforcement[0].area", "or give bar_diameter"),
+    (('bar_diameter = 10.0', 'bar_diameter = -10.0'), "reinforcement[0].bar_diameter", "greater than 0"),
+    (('strength_class = "C30/37"', 'f_c = 38.0'), "materials.c30", "missing: E, f_ct, G_F, G_c, eps_c1"),
+    (('height = 30.0', 'height = 160.0'), "reinforcement[0].height", "160 thick"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "units"),
 ])
 def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
     text = strip_model(6, 4)
@@ -168,6 +177,18 @@ def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
         build(parse(text.replace(*edit)))
     msg = str(err.value)
     assert field in msg and fix in msg, msg
+
+
+def test_crack_band_limit_names_the_largest_element():
+    """A G_F that puts the snap-back limit 2 G_F E / f_ct² below the band of 250 mm elements: the
+    error names the largest element size that passes (between the 250 mm that fail and the
+    167 mm of the next mesh with a node row at the load), and that mesh builds."""
+    gf = 'strength_class = "C30/37"\nG_F = 0.02'
+    with pytest.raises(InputError, match="snap-back limit") as err:
+        build(parse(strip_model(6, 4).replace('strength_class = "C30/37"', gf)))
+    size = float(re.search(r"elements up to ([0-9.]+) across", str(err.value)).group(1))
+    assert 1500.0 / 9 < size < 1500.0 / 6
+    build(parse(strip_model(9, 4).replace('strength_class = "C30/37"', gf)))
 
 
 def test_crack_width_probe_needs_a_concrete_layer():
@@ -235,6 +256,9 @@ def test_strip_cracks_then_yields_and_restarts_exactly(tmp_path):
     assert sig[0] < 0.1 * B500.f_y and B500.f_y <= sig[-1] < B500.f_y + B500.E_h * 0.05
     dis = np.array([r["dissipated_material"] for r in res.summary["steps"]])
     assert np.all(np.diff(dis) >= -1e-9) and dis[-1] > 0
+    cells = material_cell_fields(res.problem.model)  # the surface files' bar state: 1 where yielded
+    state, stress = cells["rebar_state_slab_b500_1"], cells["rebar_stress_slab_b500_1"]
+    assert state.max() == 1 and np.array_equal(state == 1, stress >= B500.f_y * (1 - 1e-9))
     part, again = stopped_and_restarted(spec, tmp_path / "part", 12)
     assert part.interrupted and again.converged
     assert np.allclose(again.u, res.u, rtol=0, atol=1e-9 * np.abs(res.u).max())

@@ -115,25 +115,28 @@ def _write_vtu(path: Path, mesh) -> None:
 
 
 def material_cell_fields(model: Model) -> dict[str, np.ndarray]:
-    """Per element of the surface mesh: the largest crack width of each concrete layer
-    (``crack_width_<layer>``) and the largest bar/yarn stress of each reinforcement sheet
-    (``rebar_stress_<layer>_<sheet>``) in the committed state; NaN where the layer is absent."""
+    """Per element of the surface mesh, in the committed state, for each concrete layer: the
+    largest crack width over its points (``crack_width_<layer>``), the normal of that widest crack
+    (``crack_normal_<layer>``, a 3D vector, zero where uncracked), the most compressive minimum
+    principal stress of the concrete (``min_principal_<layer>``); for each reinforcement sheet the
+    largest bar/yarn stress (``rebar_stress_<layer>_<sheet>``) and its state over the element's
+    points (``rebar_state_<layer>_<sheet>``: 0 elastic, 1 yielded, 2 ruptured). NaN where the
+    layer is absent."""
+    from . import material_output as mo
     from .element.inelastic import layer_point_values
 
     out: dict[str, np.ndarray] = {}
     n = model.mesh.n_elements
     for k, ly in enumerate(model.layers):
-        fields = [("crack_width", None, f"crack_width_{ly.name}")] if ly.law is not None else []
-        fields += [("rebar_stress", r.name, f"rebar_stress_{ly.name}_{r.name}".replace(" ", "_"))
-                   for r in ly.reinforcement]
-        for quantity, sheet, name in fields:
-            v, el = layer_point_values(model, k, quantity, sheet)
-            cell = np.full(n, np.nan)
-            if v.size:
-                cell[:] = -np.inf
-                np.maximum.at(cell, el, v)
-                cell[np.isneginf(cell)] = np.nan
-            out[name] = cell
+        if ly.law is not None and hasattr(ly.law, "crack"):
+            w, nv, el = mo.crack_points(model, k)
+            out[f"crack_width_{ly.name}"] = mo.per_element(n, w, el)
+            out[f"crack_normal_{ly.name}"] = mo.widest_normal(n, w, nv, el)
+            out[f"min_principal_{ly.name}"] = mo.per_element(n, *mo.principal_min(model, k), how="min")
+        for r in ly.reinforcement:
+            tag = f"{ly.name}_{r.name}".replace(" ", "_")
+            out[f"rebar_stress_{tag}"] = mo.per_element(n, *layer_point_values(model, k, "rebar_stress", r.name))
+            out[f"rebar_state_{tag}"] = mo.per_element(n, *mo.sheet_states(model, k, r.name))
     return out
 
 

@@ -655,6 +655,8 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
     - ``deformed.png``: the deformed reference surface coloured by |u| (last converged step);
     - ``thickness_<probe>.png``: for every stress probe at a ``point``, its component through
       all layers at that point (last converged step), the probe's own Θ³ marked;
+    - ``cracks_<layer>.png`` for every concrete layer: its crack pattern in plan, the widest crack
+      over the thickness at each in-plane Gauss point (:func:`layershell.crack_plot.plot_cracks`);
     - with delamination: ``debonded_zone_<interface>.png`` (one panel per step of
       ``[output] zone_steps``, default: first debonding and last step) and
       ``load_debonded_area.png``.
@@ -694,6 +696,14 @@ def write_figures(out, spec, problem, u: np.ndarray, summary: dict, zones: ZoneH
 
     if through_thickness is not None:  # the sampler is handed in (runner.through_thickness): no import circle
         files.update(_thickness_figures(out, spec, problem, u, summary, through_thickness))
+
+    for k, ly in enumerate(model.layers):
+        if ly.law is not None and hasattr(ly.law, "crack") and model.point_states.get(k):
+            from .crack_plot import plot_cracks
+
+            f = f"cracks_{_safe(ly.name)}.png"
+            info = plot_cracks(out / f, model, k, lam[-1])[1]
+            files[f] = {"layer": ly.name, "cracked_points": info["cracked_points"], "max_width": info["max_width"]}
 
     ctl = problem.interfaces
     if ctl is not None and zones is not None and zones.steps:

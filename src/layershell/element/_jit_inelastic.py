@@ -39,12 +39,17 @@ def full_strains(g, U, nonlinear, E):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  # pragma: no cover
+def full_terms(g, dV, S, D, U, nonlinear, want_k, want_geo, f, W, GS, GT):  # pragma: no cover
     """Per point of the full element, with the law's stress S (e, q, 6) and tangent D (e, q, 6, 6):
-    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the rows X (e, q, 6, a, 3) = B and
-    Y = (D dV) B (K_mat = Xᵀ Y), and the geometric operands GS = g S dV, GT = g (e, a, q, 3).
-    As in ``_jit.point_terms``: B_W,(a i) = Σ_K g_aK Φ_WKi with Φ_WKi = Σ_J F_iJ [Voigt(J, K) = W]
-    and (D dV B)_W,(a i) = Σ_K g_aK Ψ_WKi with Ψ_WKi = Σ_J F_iJ (D dV)_W,Voigt(J, K)."""
+    internal force f (e, a, 3) = Σ_q Bᵀ S dV; on request the operands W (e, 3, 3, q, 3, a) of the
+    material stiffness in gradient form, K_(a i)(b k) = Σ_(q, K) g_aK W[i, k, q, K, b], and the
+    geometric operands GS = g S dV, GT = g (e, a, q, 3).
+
+    As in ``_jit.point_terms``: B_V,(a i) = Σ_K g_aK Φ_VKi with Φ_VKi = Σ_J F_iJ [Voigt(J, K) = V]
+    and (D dV B)_V,(b k) = Σ_L g_bL Ψ_VLk with Ψ_VLk = Σ_J F_kJ (D dV)_V,Voigt(J, L), so that
+    Bᵀ D B dV = Σ_(K, L) g_aK A_iKkL g_bL with the 9 × 9 A_iKkL = Σ_V Φ_VKi Ψ_VLk, and
+    W[i, k, q, K, b] = Σ_L A_iKkL g_bL: 9 products of a × 3q by 3q × a per element, half the
+    work of Bᵀ (D B) over the 6q Voigt rows."""
     ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
     H = np.empty((3, 3))
     F = np.empty((3, 3))
@@ -52,6 +57,7 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
     P = np.empty((3, 3))
     Phi = np.empty((6, 3, 3))
     Psi = np.empty((6, 3, 3))
+    A = np.empty((3, 3, 3, 3))
     for e in range(ne):
         for a in range(na):
             for i in range(3):
@@ -81,30 +87,45 @@ def full_terms(g, dV, S, D, U, nonlinear, want_x, want_geo, f, X, Y, GS, GT):  #
                 g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
                 for i in range(3):
                     f[e, a, i] += g0 * P[0, i] + g1 * P[1, i] + g2 * P[2, i]
-            if want_x:
-                for W in range(6):
+            if want_k:
+                for V in range(6):
                     for K in range(3):
                         for i in range(3):
-                            Phi[W, K, i] = 0.0
+                            Phi[V, K, i] = 0.0
                             s = 0.0
                             for J in range(3):
-                                V = _VMAP[J, K]
-                                s += F[i, J] * D[e, q, W, V]
-                                if V == W:
-                                    Phi[W, K, i] += F[i, J]
-                            Psi[W, K, i] = s * w
-                for W in range(6):
-                    for a in range(na):
-                        g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
-                        for i in range(3):
-                            X[e, q, W, a, i] = g0 * Phi[W, 0, i] + g1 * Phi[W, 1, i] + g2 * Phi[W, 2, i]
-                            Y[e, q, W, a, i] = g0 * Psi[W, 0, i] + g1 * Psi[W, 1, i] + g2 * Psi[W, 2, i]
+                                X = _VMAP[J, K]
+                                s += F[i, J] * D[e, q, V, X]
+                                if X == V:
+                                    Phi[V, K, i] += F[i, J]
+                            Psi[V, K, i] = s * w
+                _gradient_form(Phi, Psi, g[e, q], A, W[e], q)
             if want_geo:
                 for a in range(na):
                     g0, g1, g2 = g[e, q, a, 0], g[e, q, a, 1], g[e, q, a, 2]
                     for K in range(3):
                         GS[e, a, q, K] = g0 * Sm[0, K] + g1 * Sm[1, K] + g2 * Sm[2, K]
                         GT[e, a, q, K] = g[e, q, a, K]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _gradient_form(Phi, Psi, gq, A, We, q):  # pragma: no cover
+    """One point's share of :func:`full_terms`' W: A_iKkL = Σ_V Φ_VKi Ψ_VLk (into ``A``), then
+    W[i, k, q, K, b] = Σ_L A_iKkL g_bL with the point's gradients ``gq`` (a, 3)."""
+    for i in range(3):
+        for K in range(3):
+            for k in range(3):
+                for L in range(3):
+                    s = 0.0
+                    for V in range(6):
+                        s += Phi[V, K, i] * Psi[V, L, k]
+                    A[i, K, k, L] = s
+    for i in range(3):
+        for k in range(3):
+            for K in range(3):
+                a0, a1, a2 = A[i, K, k, 0], A[i, K, k, 1], A[i, K, k, 2]
+                for b in range(gq.shape[0]):
+                    We[i, k, q, K, b] = a0 * gq[b, 0] + a1 * gq[b, 1] + a2 * gq[b, 2]
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -148,11 +169,11 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
     C0 = np.empty((6, 6))
     R = np.empty((6, nT))
     L = np.empty((nT, 6))
-    Cl = np.empty((nT, nT))
-    sl = np.empty(nT)
     for e in range(ne):
         for z in range(nz):
+            sl = sig[e, z]  # the level's tie stresses and tied stiffness, summed in place
             sl[:] = 0.0
+            Cl = Ch[e, z] if tangent else Ch[0, 0]
             if tangent:
                 Cl[:] = 0.0
             for q in range(9):
@@ -186,13 +207,6 @@ def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # 
                     for j2 in range(qn[q]):
                         Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
             _correct(v[e, z], comp, tangent, sl, Cl, S0, R, L, C0)
-            for k in range(nT):
-                sig[e, z, k] = sl[k]
-            if not tangent:
-                continue
-            for k in range(nT):
-                for l in range(nT):
-                    Ch[e, z, k, l] = Cl[k, l]
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -228,3 +242,72 @@ def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
         for l in range(nT):
             vl, cl = v[l], comp[l]
             Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def sheet_strain(g, a, U, nonlinear, ga, Fa, eps):  # pragma: no cover
+    """A reinforcement sheet's strain along its direction a (e, q, 3) at its points,
+    ε = (∇u a)·a (+ ½ |∇u a|² with ``nonlinear``), from the basis gradients g (e, q, n, 3) and the
+    nodal vectors U (e, n, 3); also g_b·a (``ga`` (e, q, n)) and F a (``Fa`` (e, q, 3); a itself
+    when linear)."""
+    ne, nq, na = g.shape[0], g.shape[1], g.shape[2]
+    for e in range(ne):
+        for q in range(nq):
+            a0, a1, a2 = a[e, q, 0], a[e, q, 1], a[e, q, 2]
+            h0 = h1 = h2 = 0.0
+            for b in range(na):
+                x = g[e, q, b, 0] * a0 + g[e, q, b, 1] * a1 + g[e, q, b, 2] * a2
+                ga[e, q, b] = x
+                h0 += x * U[e, b, 0]
+                h1 += x * U[e, b, 1]
+                h2 += x * U[e, b, 2]
+            s = h0 * a0 + h1 * a1 + h2 * a2
+            if nonlinear:
+                s += 0.5 * (h0 * h0 + h1 * h1 + h2 * h2)
+                Fa[e, q, 0], Fa[e, q, 1], Fa[e, q, 2] = a0 + h0, a1 + h1, a2 + h2
+            else:
+                Fa[e, q, 0], Fa[e, q, 1], Fa[e, q, 2] = a0, a1, a2
+            eps[e, q] = s
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def sheet_add(ga, Fa, sw, cw, nonlinear, tangent, f, K):  # pragma: no cover
+    """Add a sheet's forces f_(b i) += Σ_q s_q (g_b·a)(F a)_i and, with ``tangent``, its stiffness
+    K_(b i)(c k) += Σ_q [c_q (g_b·a)(F a)_i (g_c·a)(F a)_k + δ_ik s_q (g_b·a)(g_c·a)] (the
+    second term with ``nonlinear``) to ``f`` (e, 3n) and ``K`` (e, 3n, 3n); s = σ A_s dA
+    (``sw``), c = E_t A_s dA (``cw``), both (e, q). Each row of K is summed over the points first
+    and added once (one pass over K per element)."""
+    ne, nq, na = ga.shape[0], ga.shape[1], ga.shape[2]
+    m = 3 * na
+    R = np.empty((nq, m))
+    CR = np.empty((nq, m))
+    row = np.empty(m)
+    for e in range(ne):
+        for q in range(nq):
+            s = sw[e, q]
+            c = cw[e, q] if tangent else 0.0
+            for b in range(na):
+                for i in range(3):
+                    x = ga[e, q, b] * Fa[e, q, i]
+                    R[q, 3 * b + i] = x
+                    CR[q, 3 * b + i] = c * x
+                    f[e, 3 * b + i] += s * x
+        if not tangent:
+            continue
+        for r in range(m):
+            for t in range(m):
+                row[t] = 0.0
+            for q in range(nq):
+                cr = CR[q, r]
+                for t in range(m):
+                    row[t] += cr * R[q, t]
+            for t in range(m):
+                K[e, r, t] += row[t]
+        if nonlinear:
+            for b in range(na):
+                for d in range(na):
+                    x = 0.0
+                    for q in range(nq):
+                        x += sw[e, q] * ga[e, q, b] * ga[e, q, d]
+                    for i in range(3):
+                        K[e, 3 * b + i, 3 * d + i] += x

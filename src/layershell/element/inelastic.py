@@ -220,34 +220,27 @@ def inelastic_block(X, H_below, H, d: int, material, law, sheets=(), n_thickness
 
 
 def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed,
-                   fast: bool = True):
+                   fast: bool = True, into=None):
     """Forces ``(e, m)``, tangent ``(e, m, m)`` (None without ``tangent``) and trial state of a sheet.
 
     With b_q = (g_a·a)(F a)_i (the row dε/dU_ai at point q, m = 3a entries), c = E_t w, s = σ w:
-    K = Σ_q c_q b_q b_qᵀ + δ_ik Σ_q s_q (g_a·a)(g_b·a) as batched BLAS products per element
-    (``fast``), or literally as einsum (the independent check)."""
+    K = Σ_q c_q b_q b_qᵀ + δ_ik Σ_q s_q (g_a·a)(g_b·a) in compiled point loops (``fast``, added to
+    the arrays ``into`` = (f, K) where given, e.g. the bulk's), or literally as einsum (the
+    independent check)."""
     if not fast:
         return _sheet_response_reference(sheet, U, nonlinear, tangent, sl, committed)
-    from . import _jit
+    from . import _jit_inelastic as jit
 
     g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
-    ga = np.matmul(g, a[..., None])[..., 0]  # (e, q, na): g_a·a
-    Ha = np.matmul(ga, U)  # (e, q, 3): ∇u a
-    eps = np.sum(Ha * a, axis=-1)
-    Fa = a + Ha if nonlinear else a
-    if nonlinear:
-        eps = eps + 0.5 * np.sum(Ha * Ha, axis=-1)
+    e, q, na = g.shape[:3]
+    ga, Fa, eps = np.empty((e, q, na)), np.empty((e, q, 3)), np.empty((e, q))
+    jit.sheet_strain(g, a, np.ascontiguousarray(U, dtype=np.float64), bool(nonlinear), ga, Fa, eps)
     sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
-    e, q = eps.shape
     trial = (trial, eps.ravel(), sig.ravel())
-    sw = sig.reshape(e, q) * w
-    B = (ga[..., :, None] * Fa[..., None, :]).reshape(e, q, -1)  # (e, q, m)
-    f = np.matmul(sw[:, None, :], B)[:, 0]
-    if not tangent:
-        return f, None, trial
-    K = np.matmul(B.transpose(0, 2, 1), B * (Et.reshape(e, q) * w)[..., None])
-    if nonlinear:
-        _jit.add_geometric(K, np.matmul(ga.transpose(0, 2, 1), ga * sw[..., None]))
+    f, K = into if into is not None else (np.zeros((e, 3 * na)), np.zeros((e, 3 * na, 3 * na)) if tangent else None)
+    cw = (Et.reshape(e, q) * w) if tangent else np.zeros((0, 0))
+    jit.sheet_add(ga, Fa, sig.reshape(e, q) * w, cw, bool(nonlinear), bool(tangent), f,
+                  K if tangent else np.zeros((0, 0, 0)))
     return f, K, trial
 
 
@@ -324,11 +317,13 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
     trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):
         q = s.w.shape[1]
+        into = (f, K) if fast else None  # the compiled sheets add into the bulk's fresh arrays
         fs, Ks, tr = sheet_response(s, U, nonlinear, tangent, sl, committed.sheets[k].take(slice(lo * q, hi * q)),
-                                    fast)
-        f = f + fs
-        if tangent:
-            K = K + Ks
+                                    fast, into)
+        if not fast:
+            f = f + fs
+            if tangent:
+                K = K + Ks
         trial_sheets.append(tr[0])
         strains.append(tr[1])
         stresses.append(tr[2])

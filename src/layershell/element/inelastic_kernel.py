@@ -8,7 +8,10 @@ factor). Elements are split over the kernels' threads (:func:`.kernel.kernel_thr
 last step.
 
 * Full element (:class:`.kernel.LayerBlock`): E from the basis gradients and U at each point,
-  B from F and the gradients, K_mat = Xᵀ Y with X = B and Y = (D dV) B stacked over the points.
+  then in gradient form K_mat,(a i)(b k) = Σ_q Σ_(K, L) g_aK A_iKkL g_bL with the 9 × 9
+  A = Φᵀ (D dV) Ψ of each point (B = g Φ, F in Φ): per (i, k) one product of the gradients
+  (a × 3q) with W_ik = A_ik g (3q × a), half the multiplications of Bᵀ (D B) over 6q Voigt rows
+  (about those of the elastic kernel's symmetric product).
 * MITC9 (:class:`.mitc.MitcBlock`): the tie-space strains E_k of each level, the Cartesian tied
   strain T Ẽ at the Gauss points (Ẽ_c(q) = Σ_t (h_t(q) + v_t) E_(c,t), the tying functions and
   the consistency correction), then in the tie space σ_k = Σ_q (h_k(q) + v_k) (Tᵀ S dV)_c and
@@ -31,6 +34,7 @@ V_ROUNDOFF = 1e-13  # |v| of the tie correction below this is round-off (v = 0 o
 _NONE3 = np.empty((0, 0, 0))  # the compiled loops' array arguments that a call does not use
 _NONE4 = np.empty((0, 0, 0, 0))
 _NONE5 = np.empty((0, 0, 0, 0, 0))
+_NONE6 = np.empty((0, 0, 0, 0, 0, 0))
 
 
 def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, stress):
@@ -87,15 +91,16 @@ def _full(block: LayerBlock, U, nonlinear: bool, tangent: bool, lo: int, hi: int
         for s in range(r0, r1, _SUB):
             t = min(s + _SUB, r1)
             nb = t - s
-            X = np.empty((nb, q, 6, a, 3)) if tangent else _NONE5
-            Y = np.empty_like(X)
+            W = np.empty((nb, 3, 3, q, 3, a)) if tangent else _NONE6
             GS = np.empty((nb, a, q, 3) if geo else (0, 0, 0, 0))
             GT = np.empty_like(GS)
             jit.full_terms(g[s:t], dV[s:t], S[s:t], Dq[s:t] if tangent else Dq, U[s:t], nonlinear, tangent, geo,
-                           f[s:t], X, Y, GS, GT)
+                           f[s:t], W, GS, GT)
             if not tangent:
                 continue
-            np.matmul(X.reshape(nb, 6 * q, m).transpose(0, 2, 1), Y.reshape(nb, 6 * q, m), out=K[s:t])
+            G = GT if geo else np.ascontiguousarray(g[s:t].transpose(0, 2, 1, 3))  # (nb, a, q, 3)
+            Kik = np.matmul(G.reshape(nb, 1, 1, a, 3 * q), W.reshape(nb, 3, 3, 3 * q, a))  # (nb, i, k, a, b)
+            K[s:t].reshape(nb, a, 3, a, 3)[...] = Kik.transpose(0, 3, 1, 4, 2)
             if geo:
                 Kg = np.matmul(GS.reshape(nb, a, 3 * q), GT.reshape(nb, a, 3 * q).transpose(0, 2, 1))
                 _jit.add_geometric(K[s:t], Kg)
@@ -167,7 +172,7 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
             t = min(s + _SUB, r1)
             nb = t - s
             sig = np.empty((nb, nz, nT))
-            Ch = np.empty((nb, nz, nT, nT)) if tangent else _NONE4
+            Ch = np.empty((nb, nz, nT, nT) if tangent else (1, 1, nT, nT))  # (1, 1, ...): the unused level
             jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], *nzw, v[s:t], tangent, sig, Ch)
             B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
             GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))

@@ -212,7 +212,29 @@ def _describe_error(err: dict) -> tuple[str, str]:
         return _fmt_loc(loc), msg
     if kind in ("float_parsing", "int_parsing") and inp in ("true", "false"):  # see schema.Strict
         return _fmt_loc(loc), f"Input should be a number, not the boolean {inp}"
+    if kind in ("greater_than", "greater_than_equal", "less_than", "less_than_equal"):
+        info = _field_info(err["loc"])
+        if info is not None and info.description:
+            return _fmt_loc(loc), f"{msg}{got}; {loc[-1]}: {_first_sentence(info.description)}"
     return _fmt_loc(loc), msg + got
+
+
+def _field_info(loc):
+    """The schema's field (pydantic FieldInfo) at the innermost key of an error location, or None."""
+    for i in range(len(loc), 0, -1):
+        if not isinstance(loc[i - 1], str):
+            continue
+        _, tp = _resolve_loc(loc[:i - 1])
+        for m in _models(tp) if tp is not None else ():
+            if loc[i - 1] in m.model_fields:
+                return m.model_fields[loc[i - 1]]
+    return None
+
+
+def _first_sentence(text: str, limit: int = 240) -> str:
+    """A field's description up to its first full stop (and at most ``limit`` characters)."""
+    head = text.split(". ")[0]
+    return head if len(head) <= limit else head[:limit].rsplit(" ", 1)[0] + " …"
 
 
 def _validation_message(exc: ValidationError, limit: int = 8) -> str:
@@ -1000,7 +1022,7 @@ def crack_spacing_notes(model: Model) -> list[str]:
 def _check_crack_band(model: Model) -> None:
     """The crack bands of every concrete layer stay below the snap-back limit of its softening
     (:meth:`layershell.laws.ConcreteLaw.check_band`), checked before the analysis."""
-    from ..element.inelastic import in_plane_band
+    from ..element.inelastic import BAND_FRACTION, in_plane_band
 
     for k, ly in enumerate(model.layers):
         if ly.law is None or not hasattr(ly.law, "check_band"):
@@ -1013,7 +1035,13 @@ def _check_crack_band(model: Model) -> None:
         try:
             ly.law.check_band(h_in, h_z, ly.name)
         except MaterialError as exc:
-            raise InputError(f"'layers[{k}]': {exc}") from None
+            lim, hz = ly.law.max_band(), float(np.max(h_z))
+            size = (f"; with these thickness points, elements up to {np.sqrt(lim**2 - hz**2) / BAND_FRACTION:.4g} "
+                    "across (√area) keep the band below it" if lim > hz else
+                    f"; the thickness-point spacing alone exceeds it, so both are needed (at least "
+                    f"{int(hz * nz // lim) + 1} thickness points); a limit this small often means G_F in other "
+                    "units than the model's force/length (N/mm for 'N, mm')")
+            raise InputError(f"'layers[{k}]': {exc}{size}") from None
 
 
 def _check_reinforcement(model: Model, mf: schema.ModelFile) -> None:

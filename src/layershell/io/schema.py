@@ -325,10 +325,14 @@ class ConcreteMat(Strict):
 
     @model_validator(mode="after")
     def _strength(self):
-        if self.strength_class is None and self.f_ck is None and None in (self.E, self.f_c, self.f_ct, self.G_F,
-                                                                             self.G_c, self.eps_c1):
-            raise ValueError("a concrete needs a strength: give strength_class = 'C30/37' (or f_ck = 30, in MPa), "
-                             "or all of E, f_c, f_ct, G_F, G_c and eps_c1 in the model's units")
+        own = ("E", "f_c", "f_ct", "G_F", "G_c", "eps_c1")
+        missing = [k for k in own if getattr(self, k) is None]
+        if self.strength_class is None and self.f_ck is None and missing:
+            given = f" (given: {', '.join(k for k in own if k not in missing)}; missing: {', '.join(missing)})" \
+                if len(missing) < len(own) else ""
+            raise ValueError("a concrete needs a strength: give strength_class = 'C30/37' (or f_ck = 30, in MPa; "
+                             "the other constants then default to the fib Model Code 2010 mean values), or all of "
+                             f"E, f_c, f_ct, G_F, G_c and eps_c1 in the model's units{given}")
         if self.strength_class is not None and self.f_ck is not None:
             raise ValueError("give strength_class or f_ck, not both")
         return self

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass
+from types import SimpleNamespace
 
 import numpy as np
 
@@ -152,10 +153,13 @@ class ConcreteLaw:
         return ConcreteState(np.full(n, self.f_ct), z, z, z, z, z, z)
 
     # -- elasticity and damage functions --------------------------------------------------------
+    def lame(self) -> tuple[float, float]:
+        """Lamé constants λ, μ of the undamaged elasticity."""
+        return self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu)), self.E / (2 * (1 + self.nu))
+
     def stiffness(self) -> np.ndarray:
         """Undamaged 6 × 6 Voigt stiffness C0 (engineering shear strains)."""
-        lam = self.E * self.nu / ((1 + self.nu) * (1 - 2 * self.nu))
-        mu = self.E / (2 * (1 + self.nu))
+        lam, mu = self.lame()
         c = np.zeros((6, 6))
         c[:3, :3] = lam
         c[[0, 1, 2], [0, 1, 2]] += 2 * mu
@@ -197,23 +201,19 @@ class ConcreteLaw:
         return 1.0 - np.where(post, keep_post, keep_pre), np.where(post, dpost, dpre)
 
     # -- response -------------------------------------------------------------------------------
-    def _compression(self, w, committed, h_c):
-        """τ⁻, r⁻, d⁻, the nominal equivalent q⁻ and the derivatives dd⁻/dw, dq⁻/dw (n, 3)."""
-        a = (self.k_b - 1.0) / (2.0 * self.k_b - 1.0)
-        m = np.minimum(w, 0.0)
-        i1 = m.sum(1)
-        dev = m - i1[:, None] / 3.0
-        s3j2 = np.sqrt(1.5 * np.sum(dev * dev, 1))
-        tau = (a * i1 + s3j2) / (1 - a)
-        dtau = (a + 1.5 * dev / np.where(s3j2 > 0, s3j2, 1.0)[:, None] * (s3j2 > 0)[:, None]) / (1 - a)
-        dtau = dtau * (w < 0)
-        load = tau > committed.r_c
-        r = np.where(load, tau, committed.r_c)
-        d, dd = self.damage_compression(r, h_c)
-        ddw = (dd * load)[:, None] * dtau
-        q = (1.0 - d) * np.maximum(tau, 0.0)
-        dq = ((1.0 - d) * (tau > 0))[:, None] * dtau - np.maximum(tau, 0.0)[:, None] * ddw
-        return r, d, ddw, q, dq
+    def _histories(self, w, committed, h_c):
+        """Per point from the effective principal stresses ``w``: r⁻, d⁻ and dd⁻/dw (n, 3) of the
+        compression, r⁺, whether it loads and dτ⁺/dw (n, 3) of the tension (module docstring: τ⁻,
+        τ⁺ = ⟨σ̄_max⟩/(1 − κ q⁻/f_c)); compiled, :func:`layershell.laws._concrete_jit.histories`."""
+        from ._concrete_jit import histories
+
+        n = w.shape[0]
+        r_c, d_c, r_t = np.empty(n), np.empty(n), np.empty(n)
+        ddc, dtau_t, load_t = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+        f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+        histories(f64(w), f64(committed.r_c), f64(committed.r_t), f64(h_c), self.E, self.f_c, self.eps_c1, self.G_c,
+                  (self.k_b - 1.0) / (2.0 * self.k_b - 1.0), KAPPA_TC, r_c, d_c, ddc, r_t, load_t, dtau_t)
+        return r_c, d_c, ddc, r_t, load_t, dtau_t
 
     def _band(self, V, w, normal, h_in, h_z):
         """Crack band from the principal direction of σ̄_max, and the row r with r @ dσ̄ = dh."""
@@ -234,8 +234,22 @@ class ConcreteLaw:
         stress and tangent take the damage of its r_t, r_c (bands of ``committed``) at frozen damage;
         the trial state is the implicit update as without it.
         """
+        u = self._update(eps, committed, h_in, h_z, normal)
         if implex is not None:
-            return self._implex(eps, committed, h_in, h_z, normal, tangent, implex)
+            return self._implex(u, committed, tangent, implex)
+        s = (1.0 - u.d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - u.d_c)[:, None] * np.minimum(u.w, 0.0)
+        sigma = np.einsum("nk,nka->na", s, u.P)
+        if not tangent:
+            return sigma, None, u.trial
+        e_t = np.zeros((u.w.shape[0], 6))
+        e_t[u.on] = u.ddt_h[u.on, None] * u.dh_row
+        return sigma, self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t), u.trial
+
+    def _update(self, eps, committed: ConcreteState, h_in, h_z, normal) -> SimpleNamespace:
+        """The implicit update at the strains ``eps``: the trial state (``trial``), the effective
+        stress σ̄ (``sbar``) with its eigenvalues ``w``, eigenvectors ``V`` and projections ``P``, the
+        damage ``d_t``, ``d_c`` and the terms of their variation (``g_t``, ``g_c`` (n, 3): dd±/dw;
+        ``on``: the points cracking now, ``ddt_h`` ∂d⁺/∂h and ``dh_row`` their band's row)."""
         eps = np.atleast_2d(np.asarray(eps, float))
         n = eps.shape[0]
         h_in, h_z = np.broadcast_to(np.asarray(h_in, float), (n,)), np.broadcast_to(np.asarray(h_z, float), (n,))
@@ -245,15 +259,7 @@ class ConcreteLaw:
                              "spacing) must be positive at every point; pass the element's sizes")
         sbar = eps @ self.stiffness()
         w, V, P = spectral.principal(sbar)
-        r_c, d_c, ddc, q, dq = self._compression(w, committed, h_in)
-
-        pos = w[:, 2] > 0
-        rho = 1.0 - KAPPA_TC * q / self.f_c
-        tau_t = np.where(pos, w[:, 2], 0.0) / rho
-        dtau_t = (tau_t * KAPPA_TC / (self.f_c * rho))[:, None] * dq
-        dtau_t[:, 2] += pos / rho
-        load_t = tau_t > committed.r_t
-        r_t = np.where(load_t, tau_t, committed.r_t)
+        r_c, d_c, ddc, r_t, load_t, dtau_t = self._histories(w, committed, h_in)
         onset = (committed.h_t <= 0) & (r_t > self.f_ct)
         on = np.flatnonzero(onset)
         h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], h_in[on], h_z[on])
@@ -270,22 +276,24 @@ class ConcreteLaw:
         nvec = np.stack([committed.n1, committed.n2, committed.n3], -1)
         nvec[on] = v_new
         trial = ConcreteState(r_t, r_c, h_t, h_in.copy(), nvec[:, 0], nvec[:, 1], nvec[:, 2])
+        return SimpleNamespace(trial=trial, sbar=sbar, w=w, V=V, P=P, d_t=d_t, d_c=d_c,
+                               g_t=(ddt_r * load_t)[:, None] * dtau_t, g_c=ddc, on=on, ddt_h=ddt_h, dh_row=dh_row)
 
-        wp, wn = np.maximum(w, 0.0), np.minimum(w, 0.0)
-        s = (1.0 - d_t)[:, None] * wp + (1.0 - d_c)[:, None] * wn
-        sigma = np.einsum("nk,nka->na", s, P)
-        if not tangent:
-            return sigma, None, trial
-        g_t = ((ddt_r * load_t)[:, None] * dtau_t)
-        g_t_row = np.einsum("nk,nka->na", g_t, P) * spectral.WEIGHT
-        g_t_row[on] += ddt_h[on, None] * dh_row
-        g_c_row = np.einsum("nk,nka->na", ddc, P) * spectral.WEIGHT
-        M = self._split_derivative(V, w, d_t, d_c)
-        sp = np.einsum("nk,nka->na", wp, P)
-        # M -= sp ⊗ g_t_row + (sbar - sp) ⊗ g_c_row as one batched (6 × 2)(2 × 6) product (broadcast
-        # outer products cost 8 times as much)
-        M -= np.matmul(np.stack([sp, sbar - sp], -1), np.stack([g_t_row, g_c_row], 1))
-        return sigma, M @ self.stiffness(), trial
+    def _tangent(self, u, d_t, d_c, rank2: bool, g_t=None, g_c=None, e_t=None) -> np.ndarray:
+        """dσ/dε (n, 6, 6) at the update ``u`` (:meth:`_update`) with the damage ``d_t``, ``d_c``: the
+        split's derivative at frozen damage and, with ``rank2``, minus σ̄⁺ ⊗ g⁺ + σ̄⁻ ⊗ g⁻ for the
+        damage's variation (compiled: :func:`layershell.laws._concrete_jit.split_tangent`)."""
+        from ._concrete_jit import split_tangent
+
+        n = u.w.shape[0]
+        lam, mu = self.lame()
+        f64 = lambda a: np.ascontiguousarray(a, dtype=np.float64)  # noqa: E731
+        none3 = np.zeros((0, 3))
+        out = np.empty((n, 6, 6))
+        split_tangent(f64(u.V), f64(u.w), f64(u.P), f64(d_t), f64(d_c), bool(rank2),
+                      f64(g_t) if rank2 else none3, f64(g_c) if rank2 else none3,
+                      f64(e_t) if rank2 else np.zeros((0, 6)), f64(u.sbar), lam, mu, out)
+        return out
 
     def extrapolate(self, previous: ConcreteState, current: ConcreteState, ratio: float = 1.0) -> ConcreteState:
         """The histories of the next increment by IMPL-EX's linear extrapolation in pseudo-time:
@@ -304,37 +312,19 @@ class ConcreteLaw:
         d_cx, _ = self.damage_compression(implex.r_c, trial.h_c)
         return np.maximum(np.abs(d_t - np.minimum(d_tx, 1.0)), np.abs(d_c - d_cx))
 
-    def _implex(self, eps, committed, h_in, h_z, normal, tangent, implex):
-        """The IMPL-EX response: σ = (1 − d̃⁺) σ̄⁺ + (1 − d̃⁻) σ̄⁻ with the damage of the extrapolated
-        histories (d̃⁺ = 0 where the point has not cracked at the last commit), its tangent at that
-        frozen damage, and the implicit trial state."""
-        _, _, trial = self.response(eps, committed, h_in, h_z, normal, False)
+    def _implex(self, u, committed, tangent, implex):
+        """The IMPL-EX response at the update ``u`` (:meth:`_update`): σ = (1 − d̃⁺) σ̄⁺ + (1 − d̃⁻) σ̄⁻
+        with the damage of the extrapolated histories (d̃⁺ = 0 where the point has not cracked at the
+        last commit), its tangent at that frozen damage, and the implicit trial state."""
         d_t, _, _ = self.damage_tension(implex.r_t, committed.h_t)
         d_t = np.where(committed.h_t > 0, d_t, 0.0)
-        d_c, _ = self.damage_compression(implex.r_c, np.broadcast_to(np.asarray(h_in, float), implex.r_c.shape))
+        d_c, _ = self.damage_compression(implex.r_c, u.trial.h_c)
         d_t, d_c = np.minimum(d_t, MAX_IMPLEX_DAMAGE), np.minimum(d_c, MAX_IMPLEX_DAMAGE)
-        sbar = np.atleast_2d(np.asarray(eps, float)) @ self.stiffness()
-        w, V, P = spectral.principal(sbar)
-        s = (1.0 - d_t)[:, None] * np.maximum(w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(w, 0.0)
-        sigma = np.einsum("nk,nka->na", s, P)
+        s = (1.0 - d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(u.w, 0.0)
+        sigma = np.einsum("nk,nka->na", s, u.P)
         if not tangent:
-            return sigma, None, trial
-        return sigma, self._split_derivative(V, w, d_t, d_c) @ self.stiffness(), trial
-
-    @staticmethod
-    def _split_derivative(V, w, d_t, d_c):
-        """d[(1 - d⁺) σ̄⁺ + (1 - d⁻) σ̄⁻]/dσ̄ at frozen damage."""
-        kt, kc = 1.0 - d_t, 1.0 - d_c
-        on = w > 0
-        a = np.where(on, kt[:, None], kc[:, None])
-        theta = np.empty((w.shape[0], 3))
-        for p, (i, j) in enumerate(spectral.PAIRS):
-            dw = w[:, i] - w[:, j]
-            dp = np.maximum(w[:, i], 0) - np.maximum(w[:, j], 0)
-            phi = np.where(on[:, i] & on[:, j], 1.0,
-                           np.where(~on[:, i] & ~on[:, j], 0.0, dp / np.where(dw != 0, dw, 1.0)))
-            theta[:, p] = kt * phi + kc * (1.0 - phi)
-        return spectral.isotropic_derivative(V, a, theta)
+            return sigma, None, u.trial
+        return sigma, self._tangent(u, d_t, d_c, False), u.trial
 
     # -- post-processing ------------------------------------------------------------------------
     def events(self, state: ConcreteState) -> dict[str, np.ndarray]:
