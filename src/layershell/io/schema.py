@@ -619,7 +619,8 @@ class Steps(Strict):
     factors: list[float] | None = Field(None, description="explicit load factors (instead of n/lambda_end)")
     tolerance: PositiveFloat = Field(1e-8, description=(
         "Newton convergence: residual norm ≤ tolerance × norm of the applied load vector λF (relative, "
-        "dimensionless)"))
+        "dimensionless); each entry of the residual less its round-off, 2 ε Σ_j |K_ij u_j| (the entries of "
+        "the quadratic directors of a thick layer carry force × length² and stall far above the others)"))
     max_iterations: PositiveInt = Field(25, le=10_000, description=(
         "Newton iterations per load increment before it is bisected (a re-solution at the same load after "
         "new debonding, which cannot be bisected, gets 4 ×)"))
