@@ -99,7 +99,7 @@ def test_uncracked_slab_bends_as_the_plate_solution():
     relative to the midpoint of the slab's edge, per unit load, is the Kirchhoff plate's with the
     same E, ν, thickness and bars (1 %): the bending of the slab. Its deflection itself is the
     plate's within 4 %: the point support and the point load add a local compliance there
-    (−2.7 % on this 6 × 6 mesh, growing slowly with refinement) that the plate has not. The load
+    (its stiffness is 2.7 % lower on this 6 × 6 mesh, more on finer ones) that the plate has not. The load
     taken at the centre is the sum of the corner reactions."""
     spec = example_spec("rc_slab_mcneice", {"n = 60\n": "factors = [0.01]\n", "\n[[probes]]\nname = \"P\"":
                                             EDGE_PROBE + "\n[[probes]]\nname = \"P\""})
@@ -139,6 +139,7 @@ def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.nd
 
 
 @pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")  # the crack probes jump as cracks open
 @pytest.mark.parametrize("n, w_ok, p_fail", [(3, 2.25, None), (6, 4.0, 9.43), (9, 2.0, 7.97)])
 def test_load_deflection_against_the_measured_curve(n, w_ok, p_fail):
     """Quarter meshes of n × n elements (152, 76 and 51 mm). The measured load is matched within
