@@ -24,7 +24,6 @@ A = 457.2              # half span (mm): the quarter model's side
 H = 44.45              # slab thickness (mm)
 E_C, NU = 28600.0, 0.15
 E_S, A_S, Z_S = 200000.0, 0.283, 11.15  # bars per direction: area per width (mm²/mm), height above the soffit (mm)
-F_CT = 2.9
 
 
 # ------------------------------------------------------------------------------ plate reference
@@ -94,28 +93,29 @@ scale = -4.0
 """
 
 
-def test_uncracked_slab_bends_as_the_plate_solution():
+def test_uncracked_slab_bends_as_the_plate_solution(tmp_path):
     """At λ = 0.01 (P ≈ 0.4 kN, below first cracking) the deflection of the measuring point
     relative to the midpoint of the slab's edge, per unit load, is the Kirchhoff plate's with the
-    same E, ν, thickness and bars (1 %): the bending of the slab. Its deflection itself is the
-    plate's within 4 %: the point support and the point load add a local compliance there
-    (its stiffness is 2.7 % lower on this 6 × 6 mesh, more on finer ones) that the plate has not. The load
-    taken at the centre is the sum of the corner reactions."""
+    same E, ν, thickness and bars within 1 % (+0.45 %: the bending of the slab), and its
+    deflection itself within 1.5 % (−0.6 %: the bearing plate, the point load and the shear
+    deformation, which the plate has not, nearly cancel). The load taken at the centre is the
+    sum of the corner reactions (0.1 %). The run writes its ParaView files (the bearing plate's
+    layer lies off the symmetry planes)."""
     spec = example_spec("rc_slab_mcneice", {"n = 60\n": "factors = [0.01]\n", "\n[[probes]]\nname = \"P\"":
                                             EDGE_PROBE + "\n[[probes]]\nname = \"P\""})
-    res = run(spec, None, write_vtu=False)
+    res = run(spec, tmp_path, write_vtu=True)
     p = res.summary["steps"][-1]["probes"]
     D = plate_bending_stiffness(E_C, NU, H, E_S, A_S, Z_S)
     w_m, w_e = corner_supported_plate(D, A, 1.0, [(76.2, 0.0), (A, 0.0)])
     assert res.summary.get("first_cracking_step") is None
-    assert p["P_load"] == pytest.approx(p["P"], rel=1e-4)
+    assert (tmp_path / "surface_0001.vtu").exists()
+    assert p["P_load"] == pytest.approx(p["P"], rel=1e-3)
     assert (p["w"] - p["w_edge"]) / p["P"] == pytest.approx(w_m - w_e, rel=0.01)
-    assert p["w"] / p["P"] == pytest.approx(w_m, rel=0.04)
-    assert p["w"] / p["P"] > w_m  # the local compliance is a softening
+    assert p["w"] / p["P"] == pytest.approx(w_m, rel=0.015)
 
 
 # ------------------------------------------------------------------------------ measured curve
-CORNER_PROBE = """
+CRACK_PROBES = """
 [[probes]]
 name = "crack_corner"
 quantity = "crack_width"
@@ -128,6 +128,20 @@ quantity = "crack_width"
 layer = "slab"
 where = "x > 377 and y > 377"
 """
+MESHES = {  # quarter meshes: element edges (the bearing plate's at 76.2 mm, the measuring point's at 381 mm)
+    "4x4": {"nx = 6": "nx = 4\nlines_x = [76.2, 381.0]", "ny = 6": "ny = 4\nlines_y = [76.2, 381.0]"},  # 76 / 152 mm
+    "6x6": {},  # 76 mm
+    "12x12": {"nx = 6": "nx = 12", "ny = 6": "ny = 12"},  # 38 mm
+}
+POINT_SUPPORT = {'layers = ["slab", "pad"]': 'layers = ["slab"]',  # no bearing plate: the slab's soffit held at one node
+                 'layer = "pad"\nface = "top"': 'layer = "slab"\nface = "top"'}
+
+
+def load_deflection(replace: dict) -> tuple[np.ndarray, np.ndarray, list]:
+    """The example run with text replacements: (w mm, P kN) from the origin, and the steps."""
+    spec = example_spec("rc_slab_mcneice", {**replace, "\n[[probes]]\nname = \"P\"": CRACK_PROBES + "\n[[probes]]\nname = \"P\""})
+    steps = run(spec, None, write_vtu=False).summary["steps"]
+    return (np.r_[0.0, [s["probes"]["w"] for s in steps]], np.r_[0.0, [s["probes"]["P"] / 1e3 for s in steps]], steps)
 
 
 def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.ndarray]:
@@ -140,28 +154,41 @@ def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.nd
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")  # the crack probes jump as cracks open
-@pytest.mark.parametrize("n, w_ok, p_fail", [(3, 2.25, None), (6, 4.0, 9.43), (9, 2.0, 7.97)])
-def test_load_deflection_against_the_measured_curve(n, w_ok, p_fail):
-    """Quarter meshes of n × n elements (152, 76 and 51 mm). The measured load is matched within
-    10 % up to the deflection w_ok; the test's initial stiffness within 2 % on every mesh.
-    6 × 6 and 9 × 9 then fail at the point support: the load falls by more than half within one
-    step at p_fail (kN), when the crack in the corner element opens by millimetres while those
-    near the load stay below 0.1 mm. The finer the mesh the earlier: the
-    stresses at a point support are singular, and the test's bearing had a finite size. The
-    3 × 3 mesh (crack band 110 mm) holds but is too soft from w = 2.5 mm on (−21 % at 5 mm)."""
-    spec = example_spec("rc_slab_mcneice", {"nx = 6": f"nx = {n}", "ny = 6": f"ny = {n}",
-                                            "\n[[probes]]\nname = \"P\"": CORNER_PROBE + "\n[[probes]]\nname = \"P\""})
-    res = run(spec, None, write_vtu=False)
-    steps = res.summary["steps"]
-    w = np.r_[0.0, [s["probes"]["w"] for s in steps]]
-    P = np.r_[0.0, [s["probes"]["P"] / 1e3 for s in steps]]
+@pytest.mark.parametrize("mesh, w_ok, worst, p_fail", [("4x4", 2.75, 0.086, None), ("6x6", 5.0, 0.086, None),
+                                                       ("12x12", 1.25, 0.078, 10.94)])
+def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
+    """The measured load is matched within 10 % up to the deflection w_ok (mm; 5.0: the whole
+    measured curve, to 10.8 kN), the largest difference there being `worst`; the test's initial
+    stiffness within 3 % on every mesh. 76 mm elements are about the crack spacing. Longer
+    ones (152 mm away from the corner, crack band 110 mm) lose the tension between the cracks
+    too early: too soft from w = 3 mm on. Shorter ones (38 mm) keep too much of it: too stiff
+    by up to 13 % from w = 1.5 mm on (docs/concrete.md, limits); there the load point punches
+    through at p_fail (kN): the load falls by more than half within one step and the measuring
+    point springs back."""
+    w, P, _ = load_deflection(MESHES[mesh])
     reached, err = within_ten_percent_up_to(w, P)
     assert reached == w_ok, err.round(3)
-    assert abs(err[0]) < 0.02
+    assert np.abs(err[EXPERIMENT[:, 0] <= w_ok]).max() == pytest.approx(worst, abs=0.002), err.round(3)
+    assert abs(err[0]) < 0.03
     drop = np.nonzero(P[1:] < 0.5 * P[:-1])[0]
     if p_fail is None:
-        assert drop.size == 0 and err[-1] < -0.15
+        assert drop.size == 0 and w[-1] > EXPERIMENT[-1, 0]
         return
+    i = drop[0]
+    assert P[i] == pytest.approx(p_fail, abs=0.05) and w[i + 1] < 0.5 * w[i]
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")
+@pytest.mark.parametrize("n, p_fail", [(6, 9.43), (9, 7.97)])
+def test_a_bare_point_support_fails_earlier_on_finer_meshes(n, p_fail):
+    """Without the bearing plate (the soffit held at one node) the slab fails at its support: the
+    load falls by more than half within one step at p_fail (kN), when the crack in the corner
+    element opens by millimetres while those near the load stay below 0.1 mm. The stresses at
+    a point support are singular: the finer mesh fails earlier, both below the measured 10.8 kN."""
+    w, P, steps = load_deflection({**POINT_SUPPORT, "nx = 6": f"nx = {n}", "ny = 6": f"ny = {n}"})
+    drop = np.nonzero(P[1:] < 0.5 * P[:-1])[0]
+    assert drop.size
     i = drop[0]
     assert P[i] == pytest.approx(p_fail, abs=0.05)
     corner, centre = steps[i]["probes"]["crack_corner"], steps[i]["probes"]["crack_centre"]
