@@ -133,8 +133,9 @@ MESHES = {  # quarter meshes: element edges (the bearing plate's at 76.2 mm, the
     "6x6": {},  # 76 mm
     "12x12": {"nx = 6": "nx = 12", "ny = 6": "ny = 12"},  # 38 mm
 }
-POINT_SUPPORT = {'layers = ["slab", "pad"]': 'layers = ["slab"]',  # no bearing plate: the slab's soffit held at one node
-                 'layer = "pad"\nface = "top"': 'layer = "slab"\nface = "top"'}
+POINT_SUPPORT = {  # no bearing plate: the slab's soffit held at one node
+    'layers = ["slab", "pad"]\nwhere = "x < 76.2 and y < 76.2"': 'layers = ["slab"]\nwhere = "x > -1.0"',
+    '[[stacks]]\nlayers = ["slab"]\n': '', 'layer = "pad"\nface = "top"': 'layer = "slab"\nface = "top"'}
 
 
 def load_deflection(replace: dict) -> tuple[np.ndarray, np.ndarray, list]:
@@ -146,8 +147,10 @@ def load_deflection(replace: dict) -> tuple[np.ndarray, np.ndarray, list]:
 
 def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.ndarray]:
     """The largest measured deflection up to which every measured load is matched within 10 %
-    by the model's load at that deflection (linear between the steps), and those differences."""
-    err = np.interp(EXPERIMENT[:, 0], w, P, right=np.nan) / EXPERIMENT[:, 1] - 1.0
+    by the model's load at that deflection (linear between the steps, along the path until the
+    deflection first falls back), and those differences."""
+    n = np.argmax(np.r_[np.diff(w) <= 0, True]) + 1
+    err = np.interp(EXPERIMENT[:, 0], w[:n], P[:n], right=np.nan) / EXPERIMENT[:, 1] - 1.0
     bad = ~(np.abs(err) <= 0.10)
     return (EXPERIMENT[:, 0][bad.argmax() - 1] if bad.any() else EXPERIMENT[-1, 0]), err
 
@@ -175,7 +178,7 @@ def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
         assert drop.size == 0 and w[-1] > EXPERIMENT[-1, 0]
         return
     i = drop[0]
-    assert P[i] == pytest.approx(p_fail, abs=0.05) and w[i + 1] < 0.5 * w[i]
+    assert P[: i + 1].max() == pytest.approx(p_fail, abs=0.05) and w[i + 1] < 0.5 * w[i]
 
 
 @pytest.mark.slow
@@ -190,6 +193,6 @@ def test_a_bare_point_support_fails_earlier_on_finer_meshes(n, p_fail):
     drop = np.nonzero(P[1:] < 0.5 * P[:-1])[0]
     assert drop.size
     i = drop[0]
-    assert P[i] == pytest.approx(p_fail, abs=0.05)
+    assert P[: i + 1].max() == pytest.approx(p_fail, abs=0.05)
     corner, centre = steps[i]["probes"]["crack_corner"], steps[i]["probes"]["crack_centre"]
     assert corner > 1.0 and centre < 0.1 and corner > 10 * steps[i - 1]["probes"]["crack_corner"]
