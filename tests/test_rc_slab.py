@@ -140,7 +140,8 @@ POINT_SUPPORT = {  # no bearing plate: the slab's soffit held at one node
 
 def load_deflection(replace: dict) -> tuple[np.ndarray, np.ndarray, list]:
     """The example run with text replacements: (w mm, P kN) from the origin, and the steps."""
-    spec = example_spec("rc_slab_mcneice", {**replace, "\n[[probes]]\nname = \"P\"": CRACK_PROBES + "\n[[probes]]\nname = \"P\""})
+    first_probe = "\n[[probes]]\nname = \"P\""
+    spec = example_spec("rc_slab_mcneice", {**replace, first_probe: CRACK_PROBES + first_probe})
     steps = run(spec, None, write_vtu=False).summary["steps"]
     return (np.r_[0.0, [s["probes"]["w"] for s in steps]], np.r_[0.0, [s["probes"]["P"] / 1e3 for s in steps]], steps)
 
@@ -162,7 +163,7 @@ def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.nd
 def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
     """The measured load is matched within 10 % up to the deflection w_ok (mm; 5.0: the whole
     measured curve, to 10.8 kN), the largest difference there being `worst`; the test's initial
-    stiffness within 3 % on every mesh. 76 mm elements are about the crack spacing. Longer
+    stiffness within 3 % on every mesh. 76 mm elements are near the crack spacing. Longer
     ones (152 mm away from the corner, crack band 110 mm) lose the tension between the cracks
     too early: too soft from w = 3 mm on. Shorter ones (38 mm) keep too much of it: too stiff
     by up to 13 % from w = 1.5 mm on (docs/concrete.md, limits); there the load point punches
