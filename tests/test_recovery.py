@@ -100,6 +100,28 @@ def test_patch_recovery_at_symmetry_planes_mirrors_the_field():
     assert np.abs(got[:, 1] - odd(mesh.nodes)).max() < 1e-11
 
 
+def test_patch_recovery_of_a_layer_off_the_symmetry_planes():
+    """A layer on elements that touch no symmetry plane (a plate under one corner of the model)
+    keeps its plain patch fits: a quadratic field is recovered exactly at its nodes."""
+    from layershell.recovery import Recovery
+
+    m0 = _rectangle_with_two_symmetry_planes()
+    mesh = m0.mesh
+    c = mesh.nodes[mesh.elements].mean(1)
+    stack = ((c[:, 0] < 0.5) & (c[:, 1] > 0.5)).astype(int)  # 4 elements at the corner x = 0, y = 1
+    layers = [m0.layers[0], Layer("b", PLY, 1, np.full(mesh.n_nodes, 0.05))]
+    m = Model(mesh, layers, [(0,), (0, 1)], stack, symmetries=m0.symmetries)
+    rec = Recovery.__new__(Recovery)
+    Recovery.__init__(rec, m, None)
+    assert set(rec.R[1]) == {0}
+    pts, _ = gauss_2d(3)
+    X = surface_points(mesh.nodes[mesh.elements], pts[:, 0], pts[:, 1]).X0.reshape(-1, 3)
+    f = lambda X: 1 + 2 * X[:, 0] - X[:, 1] + 0.5 * X[:, 0] * X[:, 1] + 0.3 * X[:, 1] ** 2  # noqa: E731
+    got = rec._apply(1, f(X)[:, None, None], ((0, 0),))[:, 0, 0]
+    at = np.unique(mesh.elements[stack == 1])
+    assert np.abs(got[at] - f(mesh.nodes[at])).max() < 1e-11
+
+
 def test_edge_nodes_are_the_boundary_off_symmetry_planes():
     """The nodes whose in-plane divergence is taken at the node instead of a one-sided patch fit
     (recovery.edge_nodes): those on boundary edges of one element, without the edges lying in a

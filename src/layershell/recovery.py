@@ -519,8 +519,8 @@ class Recovery:
             has = np.array([k in model.stacks[s] for s in model.element_stack])
             R = {0: spr_operator(model, self.inc, has, n_gauss, degree, patch)}
             self.R_plain[k] = R[0]
-            if (axes > 0).any():
-                Rm = mirrored_operators(model, self.inc, has, axes, n_gauss, degree)
+            Rm = mirrored_operators(model, self.inc, has, axes, n_gauss, degree) if (axes > 0).any() else {}
+            if Rm:  # the layer reaches a symmetry plane (else its plain fits are complete)
                 keep = sp.diags((axes == 0).astype(float))
                 R = {g: Rm.get(g, 0) + (keep @ R[0] if g == 0 else 0) for g in Rm}
             self.R[k] = R
