@@ -17,6 +17,15 @@ With the film clamped at the delamination front and E' = E/(1 − ν²):
 - the share of mode II in G is B = sin² ψ, and with the Benzeggagh–Kenane criterion of the
   cohesive law (G_c = G_Ic + (G_IIc − G_Ic) B^η) the delamination grows where G = G_c(B).
 
+On a base of finite thickness H held flat (every point held across the interface, free in its
+plane), the axial force is the same in every section: the base under the delamination carries
+the film's relief ΔP as well, its strain ε_b = ε + ΔP/(E_b H) (E_b its axial modulus), and the
+buckled film follows the base's shortening, δ = t sqrt(4/3 (E' ε_b/σ_c − 1)). Then (the layered
+beam of Suo & Hutchinson 1990, the base arm rigid in bending)
+G = (1/(2E')) (ΔP²/t + 12 M²/t³) + ΔP²/(2 E_b H) with the film's edge moment M = σ_c t δ/2, and
+tan ψ = (m cos ω + p sin ω)/(p cos ω − m sin ω), p = ΔP/(σ_c t), m = 2√3 M/(σ_c t²); the thick
+base (H → ∞, ε_b = ε) gives the thin-film forms above. ``base = (H, E_b)`` selects it.
+
 All functions take NumPy arrays (elementwise) where they say so.
 """
 from __future__ import annotations
@@ -38,34 +47,47 @@ def critical_stress(E: float, nu: float, t: float, a: float) -> float:
     return np.pi**2 * plane_strain_modulus(E, nu) * t * t / (12.0 * a * a)
 
 
-def energy_release_rate(strain, E: float, nu: float, t: float, a):
-    """G at each front for the film's compressive strain ``strain`` (positive, plane strain:
-    σ = E' ε) where it is bonded: G0 (1 − σ_c/σ)(1 + 3 σ_c/σ) beyond buckling, 0 below it."""
+def _edge_loads(strain, E: float, nu: float, t: float, a, base):
+    """p = ΔP/(σ_c t) and m = 2√3 M/(σ_c t²) at the front, σ_c, and whether the film has buckled."""
     Ep = plane_strain_modulus(E, nu)
+    sc = critical_stress(E, nu, t, np.asarray(a, float))
     sig = Ep * np.asarray(strain, float)
-    r = critical_stress(E, nu, t, np.asarray(a, float)) / np.maximum(sig, 1e-300)
-    G = t * sig**2 / (2.0 * Ep) * (1.0 - r) * (1.0 + 3.0 * r)
-    return np.where(r < 1.0, G, 0.0)
+    dP = t * np.maximum(sig - sc, 0.0)
+    sig_b = sig if base is None else sig + Ep * dP / (base[1] * base[0])  # the base's strain times E'
+    m = np.sqrt(3.0) * np.sqrt(4.0 / 3.0 * np.maximum(sig_b / sc - 1.0, 0.0))  # √3 δ/t
+    return dP / (sc * t), m, sc, sig > sc
 
 
-def buckle_height(strain, E: float, nu: float, t: float, a):
-    """δ = t sqrt(4/3 (σ/σ_c − 1)): the height of the buckled film at the middle (0 below σ_c)."""
-    ratio = plane_strain_modulus(E, nu) * np.asarray(strain, float) / critical_stress(E, nu, t, np.asarray(a, float))
-    return t * np.sqrt(4.0 / 3.0 * np.maximum(ratio - 1.0, 0.0))
+def energy_release_rate(strain, E: float, nu: float, t: float, a, base: tuple[float, float] | None = None):
+    """G at each front for the film's compressive strain ``strain`` (positive, plane strain:
+    σ = E' ε) where it is bonded: with a thick base (``base`` None) G0 (1 − σ_c/σ)(1 + 3 σ_c/σ),
+    on a base (H, E_b) held flat the layered-beam form of the module docstring; 0 below σ_c."""
+    p, m, sc, buckled = _edge_loads(strain, E, nu, t, a, base)
+    G = sc * sc * t / (2.0 * plane_strain_modulus(E, nu)) * (p * p + m * m)
+    if base is not None:
+        G = G + (p * sc * t) ** 2 / (2.0 * base[1] * base[0])
+    return np.where(buckled, G, 0.0)
 
 
-def mode_angle(strain, E: float, nu: float, t: float, a, omega: float = OMEGA_THIN_FILM):
+def buckle_height(strain, E: float, nu: float, t: float, a, base: tuple[float, float] | None = None):
+    """δ = t sqrt(4/3 (σ_b/σ_c − 1)): the height of the buckled film at the middle (0 below σ_c),
+    σ_b = E' ε_b (= σ on a thick base)."""
+    return t * _edge_loads(strain, E, nu, t, a, base)[1] / np.sqrt(3.0)
+
+
+def mode_angle(strain, E: float, nu: float, t: float, a, omega: float = OMEGA_THIN_FILM,
+               base: tuple[float, float] | None = None):
     """ψ (radians, in (−π, 0)) of the front beyond buckling: tan ψ = K_II/K_I as in the module
     docstring; −π/2 is pure mode II."""
-    xi = buckle_height(strain, E, nu, t, a) / t
-    num = 4.0 * np.cos(omega) + np.sqrt(3.0) * xi * np.sin(omega)
-    den = -4.0 * np.sin(omega) + np.sqrt(3.0) * xi * np.cos(omega)
-    return np.arctan2(-num, -den)  # K_I ∝ −den > 0 below pure mode II, K_II ∝ −num < 0
+    p, m, _, _ = _edge_loads(strain, E, nu, t, a, base)
+    return np.arctan2(-(m * np.cos(omega) + p * np.sin(omega)), m * np.sin(omega) - p * np.cos(omega))
 
 
-def mode_ii_share(strain, E: float, nu: float, t: float, a, omega: float = OMEGA_THIN_FILM):
-    """B = G_II/G = sin² ψ."""
-    return np.sin(mode_angle(strain, E, nu, t, a, omega)) ** 2
+def mode_ii_share(strain, E: float, nu: float, t: float, a, omega: float = OMEGA_THIN_FILM,
+                  base: tuple[float, float] | None = None):
+    """B = G_II/G = sin² ψ (of the film's share of G: the base's term ΔP²/(2 E_b H) is left out
+    of the mix)."""
+    return np.sin(mode_angle(strain, E, nu, t, a, omega, base)) ** 2
 
 
 def bk_toughness(B, G_Ic: float, G_IIc: float, eta: float):
@@ -74,17 +96,23 @@ def bk_toughness(B, G_Ic: float, G_IIc: float, eta: float):
 
 
 def growth_strain(E: float, nu: float, t: float, a: float, G_Ic: float, G_IIc: float | None = None,
-                  eta: float = 2.0, omega: float = OMEGA_THIN_FILM) -> float:
+                  eta: float = 2.0, omega: float = OMEGA_THIN_FILM, base: tuple[float, float] | None = None) -> float:
     """The film's compressive strain at which the delamination of width 2a starts to grow:
     G = G_c(B) with the mode mix B of the front (:func:`mode_ii_share`); with ``G_IIc`` None the
     toughness G_Ic regardless of the mode. Raises ValueError where growth would need a state
-    past pure mode II (σ/σ_c > 7.55: the front closes and the formula does not hold)."""
+    past pure mode II (on a thick base σ/σ_c > 7.55: the front closes and the formula does not
+    hold)."""
     eps_c = critical_stress(E, nu, t, a) / plane_strain_modulus(E, nu)
-    eps_ii = eps_c * (1.0 + 4.0 * np.tan(omega) ** 2)  # pure mode II
+
+    def opening(e: float) -> float:  # ∝ K_I: zero at pure mode II
+        p, m, _, _ = _edge_loads(e, E, nu, t, a, base)
+        return float(m * np.sin(omega) - p * np.cos(omega))
+
+    eps_ii = brentq(opening, eps_c * (1.0 + 1e-9), 1e3 * eps_c, xtol=1e-14 * eps_c, rtol=1e-12)
 
     def excess(e: float) -> float:
-        Gc = G_Ic if G_IIc is None else bk_toughness(mode_ii_share(e, E, nu, t, a, omega), G_Ic, G_IIc, eta)
-        return float(energy_release_rate(e, E, nu, t, a)) - float(Gc)
+        Gc = G_Ic if G_IIc is None else bk_toughness(mode_ii_share(e, E, nu, t, a, omega, base), G_Ic, G_IIc, eta)
+        return float(energy_release_rate(e, E, nu, t, a, base)) - float(Gc)
 
     if excess(eps_ii) < 0.0:
         raise ValueError(f"the film of t = {t} over 2a = {2 * a} reaches pure mode II (strain {eps_ii:.4g}) "
