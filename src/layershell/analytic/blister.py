@@ -24,7 +24,8 @@ buckled film follows the base's shortening, δ = t sqrt(4/3 (E' ε_b/σ_c − 1)
 beam of Suo & Hutchinson 1990, the base arm rigid in bending)
 G = (1/(2E')) (ΔP²/t + 12 M²/t³) + ΔP²/(2 E_b H) with the film's edge moment M = σ_c t δ/2, and
 tan ψ = (m cos ω + p sin ω)/(p cos ω − m sin ω), p = ΔP/(σ_c t), m = 2√3 M/(σ_c t²); the thick
-base (H → ∞, ε_b = ε) gives the thin-film forms above. ``base = (H, E_b)`` selects it.
+base (H → ∞, ε_b = ε) gives the thin-film forms above. ``base = (H, E_b)`` selects it; ω keeps
+the thick substrate's value.
 
 All functions take NumPy arrays (elementwise) where they say so.
 """
@@ -32,6 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.optimize import brentq
+
+from layershell.material import MaterialError
 
 #: ω of Suo & Hutchinson (1990) for a thin film on a thick substrate of the same material (α = β = 0, h/H → 0)
 OMEGA_THIN_FILM = np.radians(52.07)
@@ -44,6 +47,11 @@ def plane_strain_modulus(E: float, nu: float) -> float:
 
 def critical_stress(E: float, nu: float, t: float, a: float) -> float:
     """σ_c = π² E' t²/(12 a²): the film over a delamination of width 2a, clamped at its fronts."""
+    for name, v in (("E", E), ("t", t), ("a", np.min(a))):
+        if not v > 0:
+            raise MaterialError(f"blister: {name} = {v} must be positive (the film's modulus, thickness and half width)")
+    if not -1.0 < nu < 0.5:
+        raise MaterialError(f"blister: nu = {nu} must lie in (-1, 0.5)")
     return np.pi**2 * plane_strain_modulus(E, nu) * t * t / (12.0 * a * a)
 
 
