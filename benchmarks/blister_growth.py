@@ -99,8 +99,10 @@ def strip_results(folders: list[Path], out: Path) -> None:
         grown = np.array([float(r["grown"]) for r in probes])
         front = np.where(grown > 0, [float(z["base/film:x_max"]) for z in zone], A)
         first = int(np.argmax(grown > 0))
-        at = [eps[np.argmax(front >= xf - 1e-6)] if front.max() >= xf - 1e-6 else np.nan for xf in (10.5, 11.0, 11.5, 12.0)]
-        print(f"{folder}: onset between ε' = {100 * eps[first - 1]:.4f} and {100 * eps[first]:.4f} %; ε' at the front "
+        at = [eps[np.argmax(front >= xf - 1e-6)] if front.max() >= xf - 1e-6 else np.nan
+              for xf in (10.5, 11.0, 11.5, 12.0)]
+        print(f"{folder}: onset between ε' = {100 * eps[first - 1]:.4f} and {100 * eps[first]:.4f} %; "
+              "ε' at the front "
               "10.5/11/11.5/12 mm: " + " / ".join(f"{100 * v:.4f}" for v in at) + f" %; {len(eps)} steps")
         ax.step(100 * eps, front, where="post", label=folder.name)
     e = np.linspace(0.00638, 0.0072, 30)
@@ -138,7 +140,8 @@ def circle(folder: Path, out: Path, n_curves: int = 5) -> None:
         front = np.array([r[deb & (idx == b)].max() if (deb & (idx == b)).any() else np.nan for b in range(32)])
         eps = float(rows[k]["eps"])
         ax.plot(0.5 * (bins[1:] + bins[:-1]), front, marker="o", ms=3, label=f"ε = {100 * eps:.3f} %")
-        print(f"step {k + 1}: ε = {100 * eps:.4f} %, front radius {np.nanmin(front):.2f} ... {np.nanmax(front):.2f} mm")
+        print(f"step {k + 1}: ε = {100 * eps:.4f} %, front radius {np.nanmin(front):.2f} ... "
+              f"{np.nanmax(front):.2f} mm")
     ax.set_xlabel("angle from x (degrees)")
     ax.set_ylabel("front radius (mm)")
     ax.legend(fontsize=8)

@@ -41,7 +41,8 @@ def test_critical_stress_and_energy_release_rate_against_hand_numbers():
     assert sc == pytest.approx(112.98, abs=0.01)
     Ep = E / (1 - NU**2)
     eps2 = 2 * sc / Ep
-    assert blister.energy_release_rate(eps2, E, NU, T, A) == pytest.approx(1.25 * T * (2 * sc) ** 2 / (2 * Ep), rel=1e-12)
+    G0 = T * (2 * sc) ** 2 / (2 * Ep)
+    assert blister.energy_release_rate(eps2, E, NU, T, A) == pytest.approx(1.25 * G0, rel=1e-12)
     assert blister.energy_release_rate(0.9 * sc / Ep, E, NU, T, A) == 0.0
 
 

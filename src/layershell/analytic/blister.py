@@ -49,7 +49,8 @@ def critical_stress(E: float, nu: float, t: float, a: float) -> float:
     """σ_c = π² E' t²/(12 a²): the film over a delamination of width 2a, clamped at its fronts."""
     for name, v in (("E", E), ("t", t), ("a", np.min(a))):
         if not v > 0:
-            raise MaterialError(f"blister: {name} = {v} must be positive (the film's modulus, thickness and half width)")
+            raise MaterialError(f"blister: {name} = {v} must be positive (the film's modulus, thickness "
+                                "and half width)")
     if not -1.0 < nu < 0.5:
         raise MaterialError(f"blister: nu = {nu} must lie in (-1, 0.5)")
     return np.pi**2 * plane_strain_modulus(E, nu) * t * t / (12.0 * a * a)
