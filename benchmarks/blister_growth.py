@@ -78,6 +78,7 @@ def strip(counts: list[int], out: Path) -> None:
         ax.step(100 * h["eps"], h["front"], where="post", label=f"{30.0 / nx:g} mm elements")
     e = np.linspace(eg, h["eps"].max(), 40)
     ax.plot(100 * e, closed_form_front(e), "k--", label="closed form (BK at the LEFM mode mix)")
+    ax.set_xlim(left=0.5)  # the buckling branch before the growth is flat
     ax.set_xlabel("film strain ε' where bonded (%)")
     ax.set_ylabel("front x_f (mm)")
     ax.legend(fontsize=8)
@@ -107,6 +108,7 @@ def strip_results(folders: list[Path], out: Path) -> None:
         ax.step(100 * eps, front, where="post", label=folder.name)
     e = np.linspace(0.00638, 0.0072, 30)
     ax.plot(100 * e, closed_form_front(e), "k--", label="closed form (BK at the LEFM mode mix)")
+    ax.set_xlim(left=0.5)  # the buckling branch before the growth is flat
     ax.set_xlabel("film strain ε' where bonded (%)")
     ax.set_ylabel("front x_f (mm)")
     ax.legend(fontsize=8)
