@@ -169,22 +169,24 @@ def three_meshes():
 
 
 @pytest.mark.slow
-def test_energy_release_rate_at_the_growing_front_lies_between_the_closed_forms(three_meshes):
+def test_energy_release_rate_at_the_growing_front_is_the_layered_beams(three_meshes):
     """Along the growth (every point row debonded at least 0.5 mm beyond the initial front, which
     the first rows' transient leaves out) the fracture energy the cohesive law dissipated at a
-    row - the energy the front released there, no friction acting - lies between the closed
-    form's G(ε', a = x) on a thick base (Hutchinson & Suo) and on the example's base of 2.5 mm
-    (its compression under the blister adds ΔP²/(2 E_b H) and lifts the buckle), at the film
-    strain of the step the row debonded in, each with 2 % for that step (ε' moves by up to 0.3 %
-    within it, G by twice that). Measured: the energies lie 6-14 % above the thick base's G and
-    0-9 % below the base's on 0.5 mm elements, 11-13 % and 2-4 % on 0.125 mm elements. They rise
-    with the front towards G_IIc, as the closed form's mode mix turns to mode II."""
+    row - the energy the front released there, no friction acting - is the closed form's G(ε',
+    a = x) on the example's base of 2.5 mm (its compression under the blister adds ΔP²/(2 E_b H)
+    and lifts the buckle) at the film strain of the step the row debonded in: within 4 % on
+    0.125 mm elements and 10 % on the coarser ones (measured: −2.3 ... +3.2 % on 0.125 and 0.25
+    mm, 0 ... +9 % on 0.5 mm elements; the step brackets the release, ε' moves by up to 0.3 %
+    within it, G by twice that); the thin film's G on a thick base, which leaves the base out,
+    stays below it (6-16 % below the fracture energy). The energy rises with the front towards
+    G_IIc, as the closed form's mode mix turns to mode II."""
     for nx, h in three_meshes.items():
         far = h["x"] > A + 0.5
         assert far.sum() >= 3, (nx, h["x"])
         e, x, frac = h["eps_debond"][far], h["x"][far], h["fracture"][far]
         thick, based = (blister.energy_release_rate(e, E, NU, T, x, b) for b in (None, BASE))
-        assert np.all((0.98 * thick < frac) & (frac < 1.02 * based)), (nx, thick, frac, based)
+        tol = 0.04 if nx == 240 else 0.10
+        assert np.all(np.abs(based / frac - 1) < tol) and np.all(thick < frac), (nx, thick, frac, based)
         assert frac[-1] > frac[0] and frac.max() < G_IIC
 
 
