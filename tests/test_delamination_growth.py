@@ -197,16 +197,19 @@ def test_onset_strain_and_front_converge_on_three_meshes_against_the_closed_form
     BK toughness at the front's LEFM mode mix (0.6379 %; measured 8-10 % below): that mix (B =
     0.9 at the onset) holds for a process zone short against the film, and this one (1.6-2 mm)
     is 3-4 film thicknesses long; the rows that debond first dissipate 0.59-0.73 N/mm (B =
-    0.64-0.79). The strain at which
-    the front reaches 10.5, 11 and 11.5 mm converges: its change from the second mesh to the
-    third is at most half of that from the first to the second, or below 0.1 % of it (with the
-    front of delamination.csv, one row behind: 0.0096 % and 0.0003 % of strain)."""
+    0.64-0.79). The front converges: the film strain at which it reaches x_f, averaged over x_f
+    = 10.5, 10.75 ... 16 mm, changes from the second mesh to the third by at most half its change
+    from the first to the second (measured: 0.0035 % and 0.0015 % of strain), and at each x_f the
+    two finer meshes agree within a load step (ε' 0.0048 %; the front is read at the steps)."""
     eg = blister.growth_strain(E, NU, T, A, G_IC, G_IIC, ETA, base=BASE)
     lo, hi = (blister.growth_strain(E, NU, T, A, g, base=BASE) for g in (G_IC, G_IIC))
+    fronts = np.arange(A + 0.5, 16.0 + 1e-9, 0.25)
     at = {}
     for nx, h in three_meshes.items():
         e0, e1 = h["onset"]
         assert lo < e0 <= e1 < hi and 0.88 * eg < e1 < eg, (nx, e0, e1, eg)
-        at[nx] = np.array([h["eps"][np.argmax(h["front"] >= xf - 1e-6)] for xf in (10.5, 11.0, 11.5)])
-    d1, d2 = np.abs(at[120] - at[60]), np.abs(at[240] - at[120])
-    assert np.all((d2 <= 0.5 * d1) | (d2 < 1e-3 * at[240])), (at, d1, d2)
+        assert h["front"].max() >= fronts[-1], (nx, h["front"].max())
+        at[nx] = np.array([h["eps"][np.argmax(h["front"] >= xf - 1e-6)] for xf in fronts])
+    m = {nx: v.mean() for nx, v in at.items()}
+    assert abs(m[240] - m[120]) <= 0.5 * abs(m[120] - m[60]), m
+    assert np.abs(at[240] - at[120]).max() < 5e-5, (at[120], at[240])
