@@ -1,6 +1,6 @@
 """The straight-sided blister: a thin film of thickness t, delaminated over a width 2a from a thick
 substrate and compressed in plane strain, buckles away from it and drives the delamination
-(Hutchinson & Suo 1992, Adv. Appl. Mech. 29, 63-191, section 6.2: the one-dimensional blister).
+(Hutchinson & Suo 1992, Adv. Appl. Mech. 29, 63-191: the one-dimensional blister).
 
 With the film clamped at the delamination front and E' = E/(1 − ν²):
 
