@@ -43,7 +43,8 @@ KAPPA_TC = 0.8  # tension-compression slope of Kupfer & Gerstle (1973), J. Eng. 
 MC2010_EPS_C1 = ((12, 1.8), (16, 1.9), (20, 2.1), (25, 2.2), (30, 2.3), (35, 2.3), (40, 2.4), (45, 2.5),
                  (50, 2.6), (55, 2.6), (60, 2.7), (70, 2.7), (80, 2.8), (90, 2.8), (100, 3.0), (120, 3.0))
 #: the largest damage an IMPL-EX step acts with: a residual stiffness of 10⁻⁶ E keeps the tangent of
-#: a fully opened crack regular (the implicit state itself goes on to d = 1)
+#: a fully opened crack regular (the implicit state itself goes on to d = 1); 10⁻⁴ E would carry
+#: the TRC strip past its stop at 6.2 mm, but leaves a separated plain beam 5 % of its peak load
 MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
 NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
 
