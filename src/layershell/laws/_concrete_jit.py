@@ -16,7 +16,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-_R2 = np.sqrt(2.0)
+from ._spectral_jit import voigt_basis
+
 
 
 @njit(cache=True, nogil=True, inline="always")
@@ -56,19 +57,7 @@ def split_tangent(V, w, P, d_t, d_c, rank2, g_t, g_c, e_t, sbar, lam, mu, out): 
         for p in range(3):
             i, j = pairs[p]
             c[3 + p] = split_coefficients(w[n, i], w[n, j], kt, kc)
-        for b in range(6):
-            if b < 3:
-                i = j = b
-                f = 1.0
-            else:
-                i, j = pairs[b - 3]
-                f = _R2
-            xi, yi, zi = V[n, 0, i], V[n, 1, i], V[n, 2, i]
-            xj, yj, zj = V[n, 0, j], V[n, 1, j], V[n, 2, j]
-            B[b, 0], B[b, 1], B[b, 2] = f * xi * xj, f * yi * yj, f * zi * zj
-            B[b, 3] = 0.5 * f * (yi * zj + zi * yj)
-            B[b, 4] = 0.5 * f * (xi * zj + zi * xj)
-            B[b, 5] = 0.5 * f * (xi * yj + yi * xj)
+        voigt_basis(V, n, B)
         for b in range(6):
             for a in range(6):
                 Bc[b, a] = B[b, a] * c[b]

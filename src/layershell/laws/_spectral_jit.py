@@ -88,6 +88,25 @@ def eigh(A: np.ndarray, projections: bool = False):
     return (w, V, P) if projections else (w, V)
 
 
+@njit(cache=True, nogil=True, inline="always")
+def voigt_basis(V, n, B):  # pragma: no cover
+    """B (6, 6): row b the Mandel vector of the eigenbasis dyad v_i ⊗ v_j of point n (b < 3: i = j = b;
+    b ≥ 3: the pair _PAIRS[b − 3], symmetrised and scaled by √2), in Voigt strain order."""
+    for b in range(6):
+        if b < 3:
+            i = j = b
+            f = 1.0
+        else:
+            i, j = _PAIRS[b - 3]
+            f = _R2
+        xi, yi, zi = V[n, 0, i], V[n, 1, i], V[n, 2, i]
+        xj, yj, zj = V[n, 0, j], V[n, 1, j], V[n, 2, j]
+        B[b, 0], B[b, 1], B[b, 2] = f * xi * xj, f * yi * yj, f * zi * zj
+        B[b, 3] = 0.5 * f * (yi * zj + zi * yj)
+        B[b, 4] = 0.5 * f * (xi * zj + zi * xj)
+        B[b, 5] = 0.5 * f * (xi * yj + yi * xj)
+
+
 @njit(cache=True, nogil=True)
 def isotropic_derivative3(V, c, out):  # pragma: no cover
     """out (n, 6, 6) = Bᵀ diag(c) B · diag(1, 1, 1, 2, 2, 2) per point, B the rows v_k ⊗ v_k
@@ -96,19 +115,7 @@ def isotropic_derivative3(V, c, out):  # pragma: no cover
     (:func:`layershell.laws.spectral.isotropic_derivative`)."""
     B = np.empty((6, 6))
     for n in range(V.shape[0]):
-        for b in range(6):
-            if b < 3:
-                i = j = b
-                f = 1.0
-            else:
-                i, j = _PAIRS[b - 3]
-                f = _R2
-            xi, yi, zi = V[n, 0, i], V[n, 1, i], V[n, 2, i]
-            xj, yj, zj = V[n, 0, j], V[n, 1, j], V[n, 2, j]
-            B[b, 0], B[b, 1], B[b, 2] = f * xi * xj, f * yi * yj, f * zi * zj
-            B[b, 3] = 0.5 * f * (yi * zj + zi * yj)
-            B[b, 4] = 0.5 * f * (xi * zj + zi * xj)
-            B[b, 5] = 0.5 * f * (xi * yj + yi * xj)
+        voigt_basis(V, n, B)
         for a in range(6):
             for d in range(6):
                 s = 0.0
