@@ -57,7 +57,7 @@ def strip(counts: list[int], out: Path) -> None:
     from test_delamination_growth import growth_history
 
     from layershell.analytic import blister
-    from layershell.plots import _figure, _save
+    from layershell.plots import _figure
 
     eg = blister.growth_strain(E, NU, T, A, G_IC, G_IIC, ETA, base=BASE)
     print(f"closed form: growth strain {100 * eg:.4f} % (BK at the LEFM mode mix), "
@@ -76,7 +76,13 @@ def strip(counts: list[int], out: Path) -> None:
               f"{100 * h['onset'][1]:.4f} %; ε' at the front 10.5/11/11.5/12 mm: "
               + " / ".join(f"{100 * v:.4f}" for v in at) + f" %; {len(h['eps'])} steps, {wall:.0f} s")
         ax.step(100 * h["eps"], h["front"], where="post", label=f"{30.0 / nx:g} mm elements")
-    e = np.linspace(eg, h["eps"].max(), 40)
+    _finish_front_figure(fig, ax, np.linspace(eg, h["eps"].max(), 40), out)
+
+
+def _finish_front_figure(fig, ax, e: np.ndarray, out: Path) -> None:
+    """The closed form's front over the film strains ``e``, axes and legend; saved as blister_front.png."""
+    from layershell.plots import _save
+
     ax.plot(100 * e, closed_form_front(e), "k--", label="closed form (BK at the LEFM mode mix)")
     ax.set_xlim(left=0.5)  # the buckling branch before the growth is flat
     ax.set_xlabel("film strain ε' where bonded (%)")
@@ -89,7 +95,7 @@ def strip(counts: list[int], out: Path) -> None:
 def strip_results(folders: list[Path], out: Path) -> None:
     import csv
 
-    from layershell.plots import _figure, _save
+    from layershell.plots import _figure
 
     fig = _figure((6.0, 4.2))
     ax = fig.add_subplot(1, 1, 1)
@@ -106,14 +112,7 @@ def strip_results(folders: list[Path], out: Path) -> None:
               "ε' at the front "
               "10.5/11/11.5/12 mm: " + " / ".join(f"{100 * v:.4f}" for v in at) + f" %; {len(eps)} steps")
         ax.step(100 * eps, front, where="post", label=folder.name)
-    e = np.linspace(0.00638, 0.0072, 30)
-    ax.plot(100 * e, closed_form_front(e), "k--", label="closed form (BK at the LEFM mode mix)")
-    ax.set_xlim(left=0.5)  # the buckling branch before the growth is flat
-    ax.set_xlabel("film strain ε' where bonded (%)")
-    ax.set_ylabel("front x_f (mm)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    print(_save(fig, out / "blister_front.png"))
+    _finish_front_figure(fig, ax, np.linspace(0.00638, 0.0072, 30), out)
 
 
 def circle(folder: Path, out: Path, n_curves: int = 5) -> None:
