@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from ._jit import add_geometric, mitc_terms
+
 _VMAP = np.array([[0, 5, 4], [5, 1, 3], [4, 3, 2]], dtype=np.int64)  # Voigt index of (J, K)
 
 
@@ -152,67 +154,9 @@ def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def mitc_tie_stress(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sig, Ch):  # pragma: no cover
-    """Tie-space stress sig (e, z, nT) = Σ_q h_qᵀ S̃_q and, with ``tangent``, the unsymmetric tied
-    stiffness Ch (e, z, nT, nT) = Σ_q h_qᵀ C̃_q h_q from the law's Cartesian S (e, z, 9, 6) and
-    D (e, z, 9, 6, 6): S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV. h_q = W_q + V: the tying functions W_q at Gauss
-    point q, given by their non-zeros (qn[q] entries: component qc, tie qk, value qw), and the
-    consistency correction V[c, k] = v[k] for c = comp[k] (the same at every q), so that
-    Ĉ = Ĉ₀ + Vᵀ R + L V + Vᵀ C0 V with Ĉ₀ = Σ_q W_qᵀ C̃_q W_q, R = Σ_q C̃_q W_q = Uᵀ Ĉ₀,
-    L = Σ_q W_qᵀ C̃_q = Ĉ₀ U and C0 = Σ_q C̃_q = Uᵀ Ĉ₀ U (U the component indicator: the tying
-    functions of a component sum to 1 at every point)."""
-    ne, nz, nT = sig.shape[0], sig.shape[1], sig.shape[2]
-    St = np.empty(6)
-    S0 = np.empty(6)
-    DT = np.empty((6, 6))
-    Ct = np.empty((6, 6))
-    C0 = np.empty((6, 6))
-    R = np.empty((6, nT))
-    L = np.empty((nT, 6))
-    for e in range(ne):
-        for z in range(nz):
-            sl = sig[e, z]  # the level's tie stresses and tied stiffness, summed in place
-            sl[:] = 0.0
-            Cl = Ch[e, z] if tangent else Ch[0, 0]
-            if tangent:
-                Cl[:] = 0.0
-            for q in range(9):
-                wq = dV[e, z, q]
-                Tq = T[e, z, q]
-                Sq = S[e, z, q]
-                for c in range(6):
-                    s = 0.0
-                    for V in range(6):
-                        s += Tq[V, c] * Sq[V]
-                    St[c] = s * wq
-                for j in range(qn[q]):
-                    sl[qk[q, j]] += qw[q, j] * St[qc[q, j]]
-                if not tangent:
-                    continue
-                Dq = D[e, z, q]
-                for V in range(6):
-                    for d in range(6):
-                        s = 0.0
-                        for W in range(6):
-                            s += Dq[V, W] * Tq[W, d]
-                        DT[V, d] = s * wq
-                for c in range(6):
-                    for d in range(6):
-                        s = 0.0
-                        for V in range(6):
-                            s += Tq[V, c] * DT[V, d]
-                        Ct[c, d] = s
-                for j1 in range(qn[q]):
-                    k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
-                    for j2 in range(qn[q]):
-                        Cl[k, qk[q, j2]] += w1 * Ct[c, qc[q, j2]] * qw[q, j2]
-            _correct(v[e, z], comp, tangent, sl, Cl, S0, R, L, C0)
-
-
-@njit(cache=True, nogil=True, fastmath=True)
 def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
     """Add the consistency correction ``v (nT,)`` of one level to its tie stresses ``sl`` and, with
-    ``tangent``, to its tied stiffness ``Cl`` (:func:`mitc_tie_stress`); nothing where v = 0."""
+    ``tangent``, to its tied stiffness ``Cl`` (:func:`_tie_level`); nothing where v = 0."""
     nT = sl.shape[0]
     anyv = False
     for k in range(nT):
@@ -242,6 +186,121 @@ def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
         for l in range(nT):
             vl, cl = v[l], comp[l]
             Cl[k, l] += vk * R[ck, l] + L[k, cl] * vl + vk * C0[ck, cl] * vl
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _tie_level(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sl, Cl, w):  # pragma: no cover
+    """One level's tie stresses ``sl (nT,)`` = Σ_q h_qᵀ S̃_q and, with ``tangent``, its unsymmetric
+    tied stiffness ``Cl (nT, nT)`` = Σ_q h_qᵀ C̃_q h_q from the law's Cartesian S (9, 6) and
+    D (9, 6, 6) at the level's Gauss points: S̃ = Tᵀ S dV, C̃ = Tᵀ D T dV. h_q = W_q + V: the tying
+    functions W_q at Gauss point q by their non-zeros (qn[q] entries: component qc, tie qk, value
+    qw; 13 of the 37 ties reach a point, so W_qᵀ C̃_q W_q is 13 × 13 scattered entries) and the
+    consistency correction V[c, k] = v[k] for c = comp[k] (:func:`_correct`). ``w``: scratch
+    (:func:`_level_scratch`)."""
+    St, DT, Cq, R, R6, L6, C6 = w
+    nT = sl.shape[0]
+    sl[:] = 0.0
+    if tangent:
+        Cl[:] = 0.0
+    for q in range(9):
+        wq, Tq = dV[q], T[q]
+        for c in range(6):
+            s = 0.0
+            for V in range(6):
+                s += Tq[V, c] * S[q, V]
+            St[c] = s * wq
+        n = qn[q]
+        for j in range(n):
+            sl[qk[q, j]] += qw[q, j] * St[qc[q, j]]
+        if not tangent:
+            continue
+        for V in range(6):  # D T dV, then Tᵀ (D T dV): inner loops along rows (vectorised)
+            DT[V, :] = 0.0
+            for W in range(6):
+                x = D[q, V, W] * wq
+                for c in range(6):
+                    DT[V, c] += x * Tq[W, c]
+        for c in range(6):
+            Cq[c, :] = 0.0
+            for V in range(6):
+                x = Tq[V, c]
+                for c2 in range(6):
+                    Cq[c, c2] += x * DT[V, c2]
+        for c in range(6):  # the columns of C̃_q at the point's ties, weighted
+            for j in range(n):
+                R[c, j] = Cq[c, qc[q, j]] * qw[q, j]
+        for j1 in range(n):
+            k, c, w1 = qk[q, j1], qc[q, j1], qw[q, j1]
+            for j2 in range(n):
+                Cl[k, qk[q, j2]] += w1 * R[c, j2]
+    _correct(v, comp, tangent, sl, Cl, St, R6, L6, C6)
+
+
+@njit(cache=True, nogil=True)
+def _level_scratch(nT, width):  # pragma: no cover
+    """The scratch arrays of :func:`_tie_level`."""
+    return (np.empty(6), np.empty((6, 6)), np.empty((6, 6)), np.empty((6, width)), np.empty((6, nT)),
+            np.empty((nT, 6)), np.empty((6, 6)))
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def _sheet_rows(ga, Fa, sw, cw, tangent, geo, f, Bs, Gs, GSs, GTs):  # pragma: no cover
+    """One element's sheet points (ga (s, n), Fa (s, 3), sw, cw (s,): :func:`sheet_add`): the rows
+    b_s = (g·a)(F a) into ``Bs`` (s, m), c_s b_s into ``Gs`` and f += Σ_s s_s b_s; with ``geo`` the
+    geometric operands s_s (g·a) and g·a into ``GSs``, ``GTs`` (s, n)."""
+    for p in range(ga.shape[0]):
+        s, c = sw[p], cw[p]
+        for b in range(ga.shape[1]):
+            for i in range(3):
+                x = ga[p, b] * Fa[p, i]
+                f[3 * b + i] += s * x
+                if tangent:
+                    Bs[p, 3 * b + i] = x
+                    Gs[p, 3 * b + i] = c * x
+            if geo:
+                GSs[p, b] = s * ga[p, b]
+                GTs[p, b] = ga[p, b]
+
+
+@njit(cache=True, nogil=True, fastmath=True)
+def mitc_bulk(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, U, d, nonlinear, tangent, S, D, dV, T,
+              qn, qc, qk, qw, comp, v, ga, Fa, sw, cw, f, K):  # pragma: no cover
+    """MITC9 forces f (e, m) and, with ``tangent``, K (e, m, m) from the law's S (e, z, 9, 6) and
+    D (e, z, 9, 6, 6) at the Gauss points, element by element (the rows of one element stay in
+    cache): the tie stresses and tied stiffness Ĉ_z of each level (:func:`_tie_level`), the rows
+    B_z and f (``_jit.mitc_terms``, tie stresses given), then K = Bᵀ G with G_z = Ĉ_z B_z (BLAS)
+    stacked over the levels, plus the geometric term. Sheets (ga (e, s, n), Fa (e, s, 3), sw, cw
+    (e, s): :func:`sheet_add`; s = 0 without) enter as s more rows b_s of B, c_s b_s of G and
+    columns of the geometric operands: the same two products."""
+    ne, nz = thL.shape[0], thL.shape[1]
+    nT, na, ns = off[6], 9 * (d + 1), ga.shape[1]
+    m, rows = 3 * na, nz * off[6]
+    geo = tangent and nonlinear
+    ncol = nz * ndir.sum() if geo else 0
+    sig, Ch = np.empty((1, nz, nT)), np.empty((nz, nT, nT))
+    w = _level_scratch(nT, qn.max())
+    Bx = np.empty((rows + ns, m) if tangent else (0, m))
+    Gx = np.empty_like(Bx)
+    GS, GT = np.empty((ncol + ns, na)), np.empty((ncol + ns, na))
+    Kg = np.empty((1, na, na))
+    E0, L0 = np.empty((0, 0, 0)), np.empty((0, 0, 0, 0))
+    B = Bx[:rows].reshape(1, nz, nT, m) if tangent else np.empty((1, 1, 1, 1))
+    for e in range(ne):
+        for z in range(nz):
+            _tie_level(S[e, z], D[e, z], dV[e, z], T[e, z], qn, qc, qk, qw, comp, v[e, z], tangent, sig[0, z],
+                       Ch[z], w)
+        mitc_terms(Nn, dNn, thL[e:e + 1], G[e:e + 1], M[e:e + 1], pts, off, nt, dirs, ndir, gn, gk, gJ, L0,
+                   U[e:e + 1], d, nonlinear, tangent, geo, False, f[e:e + 1], B, GS[:ncol].reshape(1, ncol, na),
+                   GT[:ncol].reshape(1, ncol, na), 2, sig, E0)
+        _sheet_rows(ga[e], Fa[e], sw[e], cw[e], tangent, geo, f[e], Bx[rows:], Gx[rows:], GS[ncol:], GT[ncol:])
+        if not tangent:
+            continue
+        for z in range(nz):
+            np.dot(Ch[z], Bx[z * nT:(z + 1) * nT], Gx[z * nT:(z + 1) * nT])
+        np.dot(Bx.T, Gx, K[e])
+        if geo:
+            np.dot(GS.T, GT, Kg[0])
+            add_geometric(K[e:e + 1], Kg)
 
 
 @njit(cache=True, nogil=True, fastmath=True)
@@ -311,3 +370,4 @@ def sheet_add(ga, Fa, sw, cw, nonlinear, tangent, f, K):  # pragma: no cover
                         x += sw[e, q] * ga[e, q, b] * ga[e, q, d]
                     for i in range(3):
                         K[e, 3 * b + i, 3 * d + i] += x
+

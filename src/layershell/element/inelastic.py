@@ -219,6 +219,21 @@ def inelastic_block(X, H_below, H, d: int, material, law, sheets=(), n_thickness
     return InelasticBlock(base, law, h_in, h_z, normal, made)
 
 
+def sheet_terms(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed):
+    """A sheet's point terms over the elements ``sl`` (compiled strains): ``(ga, Fa, sw, cw)`` with
+    g_b·a (e, q, n), F a (e, q, 3), s = σ A_s dA and c = E_t A_s dA (e, q; c None without
+    ``tangent``), and the trial (state, strain, stress)."""
+    from . import _jit_inelastic as jit
+
+    g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
+    e, q, na = g.shape[:3]
+    ga, Fa, eps = np.empty((e, q, na)), np.empty((e, q, 3)), np.empty((e, q))
+    jit.sheet_strain(g, a, np.ascontiguousarray(U, dtype=np.float64), bool(nonlinear), ga, Fa, eps)
+    sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
+    cw = np.ascontiguousarray(Et.reshape(e, q) * w) if tangent else None
+    return (ga, Fa, np.ascontiguousarray(sig.reshape(e, q) * w), cw), (trial, eps.ravel(), sig.ravel())
+
+
 def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, committed,
                    fast: bool = True, into=None):
     """Forces ``(e, m)``, tangent ``(e, m, m)`` (None without ``tangent``) and trial state of a sheet.
@@ -231,15 +246,10 @@ def sheet_response(sheet: Sheet, U: np.ndarray, nonlinear: bool, tangent: bool, 
         return _sheet_response_reference(sheet, U, nonlinear, tangent, sl, committed)
     from . import _jit_inelastic as jit
 
-    g, a, w = sheet.g[sl], sheet.a[sl], sheet.w[sl]
-    e, q, na = g.shape[:3]
-    ga, Fa, eps = np.empty((e, q, na)), np.empty((e, q, 3)), np.empty((e, q))
-    jit.sheet_strain(g, a, np.ascontiguousarray(U, dtype=np.float64), bool(nonlinear), ga, Fa, eps)
-    sig, Et, trial = sheet.law.response(eps.ravel(), committed, tangent)
-    trial = (trial, eps.ravel(), sig.ravel())
+    (ga, Fa, sw, cw), trial = sheet_terms(sheet, U, nonlinear, tangent, sl, committed)
+    e, q, na = ga.shape
     f, K = into if into is not None else (np.zeros((e, 3 * na)), np.zeros((e, 3 * na, 3 * na)) if tangent else None)
-    cw = (Et.reshape(e, q) * w) if tangent else np.zeros((0, 0))
-    jit.sheet_add(ga, Fa, sig.reshape(e, q) * w, cw, bool(nonlinear), bool(tangent), f,
+    jit.sheet_add(ga, Fa, sw, cw if tangent else np.zeros((0, 0)), bool(nonlinear), bool(tangent), f,
                   K if tangent else np.zeros((0, 0, 0)))
     return f, K, trial
 
@@ -290,29 +300,49 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
     plain NumPy forms (the independent check)."""
     lo, hi, _ = sl.indices(block.h_in.shape[0])
     sl = slice(lo, hi)
-    trial_bulk = None
+    if block.law is None or not fast:
+        return _separate_response(block, U, nonlinear, tangent, sl, committed, implex, fast)
+    from .inelastic_kernel import bulk_response
+
+    stress, out = _bulk_stress(block, sl, committed, implex, tangent)
+    terms = [sheet_terms(s, U, nonlinear, tangent, sl, committed.sheets[k].take(slice(lo * s.w.shape[1],
+                                                                                        hi * s.w.shape[1])))
+             for k, s in enumerate(block.sheets)]
+    f, K = bulk_response(block.base, U, nonlinear, tangent, sl, stress, tuple(t[0] for t in terms))
+    return f, K, LayerState(out["trial"], tuple(t[1][0] for t in terms), out["strain"],
+                            tuple(t[1][1] for t in terms), tuple(t[1][2] for t in terms))
+
+
+def _bulk_stress(block: InelasticBlock, sl: slice, committed: LayerState, implex, tangent: bool):
+    """The bulk law as ``stress(E) -> (S, D)`` over the elements ``sl`` (:func:`.inelastic_kernel.bulk_response`),
+    and the dict its strain and trial state are left in."""
+    lo, hi = sl.start, sl.stop
+    P = block.n_points
+    c = committed.bulk.take(slice(lo * P, hi * P))
+    extra = {} if implex is None else {"implex": implex.bulk.take(slice(lo * P, hi * P))}
+    out = {}
+
+    def stress(E):
+        out["strain"] = E.reshape(-1, 6)
+        S, D, out["trial"] = block.law.response(out["strain"], c, block.h_in[sl].ravel(), block.h_z[sl].ravel(),
+                                                block.normal[sl].reshape(-1, 3), tangent, **extra)
+        ne = E.shape[0]
+        return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
+
+    return stress, out
+
+
+def _separate_response(block: InelasticBlock, U, nonlinear: bool, tangent: bool, sl: slice, committed: LayerState,
+                       implex, fast: bool):
+    """:func:`inelastic_response` with the sheets added after the bulk: the elastic bulk (no law)
+    or the plain NumPy forms of both (``fast=False``)."""
+    lo, hi = sl.start, sl.stop
+    trial_bulk, out = None, {}
     if block.law is None:
         f, K = layer_response(block.base, U, nonlinear, tangent, sl)
     else:
-        P = block.n_points
-        c = committed.bulk.take(slice(lo * P, hi * P))
-        extra = {} if implex is None else {"implex": implex.bulk.take(slice(lo * P, hi * P))}
-        out = {}
-
-        def stress(E):
-            out["strain"] = E.reshape(-1, 6)
-            S, D, out["trial"] = block.law.response(out["strain"], c, block.h_in[sl].ravel(),
-                                                    block.h_z[sl].ravel(), block.normal[sl].reshape(-1, 3), tangent,
-                                                    **extra)
-            ne = E.shape[0]
-            return S.reshape(ne, P, 6), (None if D is None else D.reshape(ne, P, 6, 6))
-
-        if fast:
-            from .inelastic_kernel import bulk_response
-
-            f, K = bulk_response(block.base, U, nonlinear, tangent, sl, stress)
-        else:
-            f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
+        stress, out = _bulk_stress(block, sl, committed, implex, tangent)
+        f, K = layer_response_reference(block.base, U, nonlinear, tangent, sl, stress)
         trial_bulk = out["trial"]
     trial_sheets, strains, stresses = [], [], []
     for k, s in enumerate(block.sheets):
@@ -327,8 +357,7 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
         trial_sheets.append(tr[0])
         strains.append(tr[1])
         stresses.append(tr[2])
-    return f, K, LayerState(trial_bulk, tuple(trial_sheets), out.get("strain") if block.law is not None else None,
-                            tuple(strains), tuple(stresses))
+    return f, K, LayerState(trial_bulk, tuple(trial_sheets), out.get("strain"), tuple(strains), tuple(stresses))
 
 
 def put_trial(full: LayerState, block: InelasticBlock, sl: slice, part: LayerState) -> None:

@@ -37,19 +37,25 @@ _NONE5 = np.empty((0, 0, 0, 0, 0))
 _NONE6 = np.empty((0, 0, 0, 0, 0, 0))
 
 
-def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, stress):
+def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slice, stress, sheets=()):
     """Forces ``(e, m)`` and tangent ``(e, m, m)`` (None without ``tangent``) of the elements ``sl``
     (contiguous) of a layer block with ``stress(E) -> (S, D)``: E ``(e, P, 6)`` the Cartesian
     Green-Lagrange strain at the block's P points (MITC9: tied; ``block.dV`` order), S ``(e, P, 6)``,
-    D ``(e, P, 6, 6)`` or None without ``tangent``."""
+    D ``(e, P, 6, 6)`` or None without ``tangent``. ``sheets``: the point terms of reinforcement
+    sheets in the layer (``(ga, Fa, sw, cw)`` each, :func:`.inelastic.sheet_terms`), added."""
     lo, hi, step = sl.indices(block.dV.shape[0])
     if step != 1:
         raise ValueError("bulk_response: the element range must be contiguous")
     U = np.ascontiguousarray(U, dtype=np.float64)
     nonlinear, tangent = bool(nonlinear), bool(tangent)
-    if isinstance(block, LayerBlock):
-        return _full(block, U, nonlinear, tangent, lo, hi, stress)
-    return _mitc(block, U, nonlinear, tangent, lo, hi, stress)
+    if not isinstance(block, LayerBlock):
+        return _mitc(block, U, nonlinear, tangent, lo, hi, stress, sheets)
+    f, K = _full(block, U, nonlinear, tangent, lo, hi, stress)
+    from . import _jit_inelastic as jit
+
+    for ga, Fa, sw, cw in sheets:
+        jit.sheet_add(ga, Fa, sw, cw if tangent else np.zeros((0, 0)), nonlinear, tangent, f, K if tangent else _NONE3)
+    return f, K
 
 
 def _threads(n_el: int, work, tangent: bool) -> None:
@@ -137,7 +143,7 @@ def _tying_nonzeros(tie):
 _NONZEROS: dict = {}  # id(tying) -> (tying, its non-zeros); the tyings are cached (mitc.tying)
 
 
-def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
+def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress, sheets):
     from . import _jit, _jit_inelastic as jit
 
     if block.T is None:
@@ -159,32 +165,27 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress):
     jit.mitc_gauss_strain(Ek, tie.w, v, tie.off, tie.n, T, Ec)
     S, D = _law(stress, Ec.reshape(e, nz * 9, 6), tangent)
     S = S.reshape(e, nz, 9, 6)
-    D = D.reshape(e, nz, 9, 6, 6) if tangent else _NONE5
+    D = D.reshape(e, nz, 9, 6, 6) if tangent else np.empty((e, nz, 0, 6, 6))
     dV = block.dV[lo:hi].reshape(e, nz, 9)
+    ga, Fa, sw, cw = _stacked(sheets, e, a, tangent)
     f = np.empty((e, m))
     K = np.empty((e, m, m)) if tangent else None
-    geo = tangent and nonlinear
-    ncol = nz * int(tie.ndir.sum())
     nzw = _tying_nonzeros(tie)
 
     def work(r0: int, r1: int) -> None:
-        for s in range(r0, r1, _SUB):
-            t = min(s + _SUB, r1)
-            nb = t - s
-            sig = np.empty((nb, nz, nT))
-            Ch = np.empty((nb, nz, nT, nT) if tangent else (1, 1, nT, nT))  # (1, 1, ...): the unused level
-            jit.mitc_tie_stress(S[s:t], D[s:t] if tangent else D, dV[s:t], T[s:t], *nzw, v[s:t], tangent, sig, Ch)
-            B = np.empty((nb, nz, nT, m) if tangent else (1, 1, 1, 1))
-            GS = np.empty((nb, ncol, a) if geo else (0, 0, 0))
-            GT = np.empty_like(GS)
-            _jit.mitc_terms(*_mitc_args(block, lo + s, lo + t), Ch, U[s:t], block.d, nonlinear, tangent, geo, False,
-                            f[s:t], B, GS, GT, 2, sig, _NONE3)
-            if not tangent:
-                continue
-            np.matmul(B.reshape(nb, nz * nT, m).transpose(0, 2, 1), np.matmul(Ch, B).reshape(nb, nz * nT, m),
-                      out=K[s:t])
-            if geo:
-                _jit.add_geometric(K[s:t], np.matmul(GS.transpose(0, 2, 1), GT))
+        jit.mitc_bulk(*_mitc_args(block, lo + r0, lo + r1), U[r0:r1], block.d, nonlinear, tangent, S[r0:r1],
+                      D[r0:r1], dV[r0:r1], T[r0:r1], *nzw, v[r0:r1], ga[r0:r1], Fa[r0:r1], sw[r0:r1], cw[r0:r1],
+                      f[r0:r1], K[r0:r1] if tangent else _NONE3)
 
     _threads(e, work, tangent)
     return f, K
+
+
+def _stacked(sheets, e: int, a: int, tangent: bool):
+    """The sheets' point terms (:func:`.inelastic.sheet_terms`) stacked along the points:
+    ga (e, s, a), Fa (e, s, 3), sw, cw (e, s); s = 0 without sheets."""
+    if not sheets:
+        return np.empty((e, 0, a)), np.empty((e, 0, 3)), np.empty((e, 0)), np.empty((e, 0))
+    cat = lambda k: np.ascontiguousarray(np.concatenate([t[k] for t in sheets], axis=1))  # noqa: E731
+    cw = cat(3) if tangent else np.empty((e, sum(t[2].shape[1] for t in sheets)))
+    return cat(0), cat(1), cat(2), cw
