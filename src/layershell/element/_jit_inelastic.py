@@ -214,18 +214,17 @@ def _tie_level(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sl, Cl, w):  # pra
             sl[qk[q, j]] += qw[q, j] * St[qc[q, j]]
         if not tangent:
             continue
-        for V in range(6):  # D T dV, then Tᵀ (D T dV): inner loops along rows (vectorised)
-            DT[V, :] = 0.0
-            for W in range(6):
-                x = D[q, V, W] * wq
-                for c in range(6):
-                    DT[V, c] += x * Tq[W, c]
+        for V in range(6):  # D T dV, then Tᵀ (D T dV): the inner loops along rows (vectorised)
+            d0, d1, d2 = D[q, V, 0] * wq, D[q, V, 1] * wq, D[q, V, 2] * wq
+            d3, d4, d5 = D[q, V, 3] * wq, D[q, V, 4] * wq, D[q, V, 5] * wq
+            for c in range(6):
+                DT[V, c] = (d0 * Tq[0, c] + d1 * Tq[1, c] + d2 * Tq[2, c] + d3 * Tq[3, c] + d4 * Tq[4, c]
+                            + d5 * Tq[5, c])
         for c in range(6):
-            Cq[c, :] = 0.0
-            for V in range(6):
-                x = Tq[V, c]
-                for c2 in range(6):
-                    Cq[c, c2] += x * DT[V, c2]
+            t0, t1, t2, t3, t4, t5 = Tq[0, c], Tq[1, c], Tq[2, c], Tq[3, c], Tq[4, c], Tq[5, c]
+            for c2 in range(6):
+                Cq[c, c2] = (t0 * DT[0, c2] + t1 * DT[1, c2] + t2 * DT[2, c2] + t3 * DT[3, c2] + t4 * DT[4, c2]
+                             + t5 * DT[5, c2])
         for c in range(6):  # the columns of C̃_q at the point's ties, weighted
             for j in range(n):
                 R[c, j] = Cq[c, qc[q, j]] * qw[q, j]
@@ -334,40 +333,19 @@ def sheet_add(ga, Fa, sw, cw, nonlinear, tangent, f, K):  # pragma: no cover
     """Add a sheet's forces f_(b i) += Σ_q s_q (g_b·a)(F a)_i and, with ``tangent``, its stiffness
     K_(b i)(c k) += Σ_q [c_q (g_b·a)(F a)_i (g_c·a)(F a)_k + δ_ik s_q (g_b·a)(g_c·a)] (the
     second term with ``nonlinear``) to ``f`` (e, 3n) and ``K`` (e, 3n, 3n); s = σ A_s dA
-    (``sw``), c = E_t A_s dA (``cw``), both (e, q). Each row of K is summed over the points first
-    and added once (one pass over K per element)."""
+    (``sw``), c = E_t A_s dA (``cw``), both (e, q) (several sheets: their points stacked). Per
+    element the rows b_q and c_q b_q (:func:`_sheet_rows`), then both terms as BLAS products."""
     ne, nq, na = ga.shape[0], ga.shape[1], ga.shape[2]
     m = 3 * na
-    R = np.empty((nq, m))
-    CR = np.empty((nq, m))
-    row = np.empty(m)
+    geo = tangent and nonlinear
+    Bs, Gs, Ks = np.empty((nq, m)), np.empty((nq, m)), np.empty((m, m))
+    GS, GT, Kg = np.empty((nq, na)), np.empty((nq, na)), np.empty((1, na, na))
     for e in range(ne):
-        for q in range(nq):
-            s = sw[e, q]
-            c = cw[e, q] if tangent else 0.0
-            for b in range(na):
-                for i in range(3):
-                    x = ga[e, q, b] * Fa[e, q, i]
-                    R[q, 3 * b + i] = x
-                    CR[q, 3 * b + i] = c * x
-                    f[e, 3 * b + i] += s * x
+        _sheet_rows(ga[e], Fa[e], sw[e], cw[e] if tangent else sw[e], tangent, geo, f[e], Bs, Gs, GS, GT)
         if not tangent:
             continue
-        for r in range(m):
-            for t in range(m):
-                row[t] = 0.0
-            for q in range(nq):
-                cr = CR[q, r]
-                for t in range(m):
-                    row[t] += cr * R[q, t]
-            for t in range(m):
-                K[e, r, t] += row[t]
-        if nonlinear:
-            for b in range(na):
-                for d in range(na):
-                    x = 0.0
-                    for q in range(nq):
-                        x += sw[e, q] * ga[e, q, b] * ga[e, q, d]
-                    for i in range(3):
-                        K[e, 3 * b + i, 3 * d + i] += x
-
+        np.dot(Bs.T, Gs, Ks)
+        K[e] += Ks
+        if geo:
+            np.dot(GS.T, GT, Kg[0])
+            add_geometric(K[e:e + 1], Kg)

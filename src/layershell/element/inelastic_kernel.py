@@ -51,10 +51,11 @@ def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slic
     if not isinstance(block, LayerBlock):
         return _mitc(block, U, nonlinear, tangent, lo, hi, stress, sheets)
     f, K = _full(block, U, nonlinear, tangent, lo, hi, stress)
-    from . import _jit_inelastic as jit
+    if sheets:
+        from . import _jit_inelastic as jit
 
-    for ga, Fa, sw, cw in sheets:
-        jit.sheet_add(ga, Fa, sw, cw if tangent else np.zeros((0, 0)), nonlinear, tangent, f, K if tangent else _NONE3)
+        ga, Fa, sw, cw = _stacked(sheets, hi - lo, block.gradphi.shape[2], tangent)
+        jit.sheet_add(ga, Fa, sw, cw, nonlinear, tangent, f, K if tangent else _NONE3)
     return f, K
 
 
