@@ -204,3 +204,22 @@ def test_compiled_kernel_splits_elements_over_threads(element, monkeypatch):
     assert np.array_equal(out["1"][0], out["3"][0]) and np.array_equal(out["1"][1], out["3"][1])
     K0 = inelastic_response(blk, U, True, True, slice(None), initial_state(blk), fast=False)[1]
     assert np.abs(out["3"][1] - K0).max() < 1e-12 * np.abs(K0).max()
+
+
+def test_blas_limit_reaches_the_blas_of_the_compiled_products():
+    """The compiled MITC9 and sheet products call SciPy's BLAS (Numba's np.dot), a library apart
+    from NumPy's: held to one thread with NumPy's by ``blas_single_thread`` even where the limit's
+    controller is made before SciPy's BLAS is loaded (checked in a fresh process, BLAS threads 2)."""
+    import os
+    import subprocess
+    import sys
+
+    code = ("from layershell.threads import blas_single_thread\n"
+            "from threadpoolctl import threadpool_info\n"
+            "with blas_single_thread():\n"
+            "    import scipy.linalg.cython_blas\n"
+            "    libs = [(i['filepath'], i['num_threads']) for i in threadpool_info() if i['user_api'] == 'blas']\n"
+            "print(len(libs), max(n for _, n in libs))\n")
+    env = {**os.environ, "OMP_NUM_THREADS": "2", "OPENBLAS_NUM_THREADS": "2"}
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, env=env).stdout.split()
+    assert int(out[0]) >= 2 and int(out[1]) == 1

@@ -22,6 +22,8 @@ def controller():
     global _CONTROLLER
     with _LOCK:
         if _CONTROLLER is None:
+            # SciPy's OpenBLAS (Numba's np.dot in the compiled kernels) loaded first: the limits reach it
+            import scipy.linalg.cython_blas  # noqa: F401
             from threadpoolctl import ThreadpoolController
 
             _CONTROLLER = ThreadpoolController()

@@ -3,7 +3,10 @@
 Imported lazily by :mod:`layershell.element.inelastic_kernel`. The material law is not evaluated
 here: these loops give the strain at the points, and from the law's stress S and tangent D there
 the internal force f = Σ Bᵀ S dV and the operands of K = Σ Bᵀ (D dV) B + the geometric term
-(``kernel.py``, ``mitc.py`` for the equations; D may be unsymmetric).
+(``kernel.py``, ``mitc.py`` for the equations; D may be unsymmetric). The MITC9 pass
+(:func:`mitc_bulk`) and the sheets (:func:`sheet_add`) form K themselves with ``np.dot`` on each
+element's rows: SciPy's BLAS, held to one thread with the others by
+:func:`layershell.threads.blas_single_thread`.
 """
 from __future__ import annotations
 
@@ -156,7 +159,11 @@ def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
 @njit(cache=True, nogil=True, fastmath=True)
 def _correct(v, comp, tangent, sl, Cl, S0, R, L, C0):  # pragma: no cover
     """Add the consistency correction ``v (nT,)`` of one level to its tie stresses ``sl`` and, with
-    ``tangent``, to its tied stiffness ``Cl`` (:func:`_tie_level`); nothing where v = 0."""
+    ``tangent``, to its tied stiffness ``Cl`` (:func:`_tie_level`, which gives them for h_q = W_q);
+    nothing where v = 0. With h_q = W_q + V, V[c, k] = v[k] for c = comp[k] (the same at every q):
+    Ĉ = Ĉ₀ + Vᵀ R + L V + Vᵀ C0 V with Ĉ₀ = Σ_q W_qᵀ C̃_q W_q, R = Σ_q C̃_q W_q = Uᵀ Ĉ₀,
+    L = Σ_q W_qᵀ C̃_q = Ĉ₀ U and C0 = Σ_q C̃_q = Uᵀ Ĉ₀ U (U the component indicator: the tying
+    functions of a component sum to 1 at every point), and likewise σ = σ₀ + Vᵀ Uᵀ σ₀."""
     nT = sl.shape[0]
     anyv = False
     for k in range(nT):
@@ -198,7 +205,6 @@ def _tie_level(S, D, dV, T, qn, qc, qk, qw, comp, v, tangent, sl, Cl, w):  # pra
     consistency correction V[c, k] = v[k] for c = comp[k] (:func:`_correct`). ``w``: scratch
     (:func:`_level_scratch`)."""
     St, DT, Cq, R, R6, L6, C6 = w
-    nT = sl.shape[0]
     sl[:] = 0.0
     if tangent:
         Cl[:] = 0.0

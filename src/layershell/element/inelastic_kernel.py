@@ -2,20 +2,23 @@
 
 Three steps per element range: the strain at the points (compiled), the law's stress S and tangent
 D = dS/dE there (vectorised over all points of the range, one call), then f = Σ Bᵀ S dV and
-K = Σ Bᵀ (D dV) B + the geometric term of S (compiled point work and one BLAS product per element;
-D may be unsymmetric, so the general product instead of the elastic kernels' syrk with a Cholesky
+K = Σ Bᵀ (D dV) B + the geometric term of S (compiled point work and BLAS products per element;
+D may be unsymmetric, so general products instead of the elastic kernels' syrk with a Cholesky
 factor). Elements are split over the kernels' threads (:func:`.kernel.kernel_threads`) in the
-last step.
+last step. Reinforcement sheets (:func:`.inelastic.sheet_terms`) are added in the same step.
 
 * Full element (:class:`.kernel.LayerBlock`): E from the basis gradients and U at each point,
   then in gradient form K_mat,(a i)(b k) = Σ_q Σ_(K, L) g_aK A_iKkL g_bL with the 9 × 9
   A = Φᵀ (D dV) Ψ of each point (B = g Φ, F in Φ): per (i, k) one product of the gradients
   (a × 3q) with W_ik = A_ik g (3q × a), half the multiplications of Bᵀ (D B) over 6q Voigt rows
-  (about those of the elastic kernel's symmetric product).
+  (about those of the elastic kernel's symmetric product); sheets by ``_jit_inelastic.sheet_add``.
 * MITC9 (:class:`.mitc.MitcBlock`): the tie-space strains E_k of each level, the Cartesian tied
   strain T Ẽ at the Gauss points (Ẽ_c(q) = Σ_t (h_t(q) + v_t) E_(c,t), the tying functions and
-  the consistency correction), then in the tie space σ_k = Σ_q (h_k(q) + v_k) (Tᵀ S dV)_c and
-  Ĉ = Σ_q h_qᵀ (Tᵀ D T dV) h_q (unsymmetric), f = Σ_k σ_k B_k and K_mat = Σ_z B_zᵀ Ĉ_z B_z.
+  the consistency correction), then element by element in one compiled pass
+  (``_jit_inelastic.mitc_bulk``): in the tie space σ_k = Σ_q (h_k(q) + v_k) (Tᵀ S dV)_c and
+  Ĉ = Σ_q h_qᵀ (Tᵀ D T dV) h_q (unsymmetric), the rows B_k and f = Σ_k σ_k B_k, and
+  K_mat = Σ_z B_zᵀ (Ĉ_z B_z) as BLAS products on the element's rows while they are in cache;
+  a sheet's points are further rows of the same products.
 
 :func:`.kernel.layer_response_reference` / :func:`.mitc.mitc_response_reference` with the same
 ``stress`` callable are the plain NumPy forms of both (tests/test_inelastic_layer.py).
@@ -29,11 +32,10 @@ import numpy as np
 from ..threads import blas_single_thread
 from .kernel import LayerBlock, _pool, kernel_threads
 
-_SUB = 8  # elements per sub-block, as the elastic kernels (16 measured no faster): rows made and multiplied at once
+_SUB = 8  # elements per sub-block of the full element (as the elastic kernels: 16 measured no faster) and per thread
 V_ROUNDOFF = 1e-13  # |v| of the tie correction below this is round-off (v = 0 on flat straight-edged elements)
 _NONE3 = np.empty((0, 0, 0))  # the compiled loops' array arguments that a call does not use
 _NONE4 = np.empty((0, 0, 0, 0))
-_NONE5 = np.empty((0, 0, 0, 0, 0))
 _NONE6 = np.empty((0, 0, 0, 0, 0, 0))
 
 
