@@ -128,11 +128,24 @@ def test_compiled_kernel_equals_the_plain_forms(element, d, nonlinear, mesh):
     """The compiled bulk kernel (element/inelastic_kernel.py) against the layer kernels' plain
     NumPy forms with the same law: forces, the unsymmetric tangent, the trial state and strains of
     an element range, with sheets, from a committed state with history."""
+    _compare_with_plain_forms(element, d, nonlinear, mesh, 3)
+
+
+def test_compiled_mitc_kernel_sums_its_product_in_pieces():
+    """d = 2 with 6 thickness points: the MITC9 product Bᵀ G (6 · 37 + 18 rows of 81 columns) is
+    summed over pieces (_jit_inelastic.PRODUCT_ENTRIES), equal to the plain forms."""
+    from layershell.element._jit_inelastic import PRODUCT_ENTRIES
+
+    assert (6 * 37 + 18) * 81 > PRODUCT_ENTRIES
+    _compare_with_plain_forms("mitc", 2, True, "distorted", 6)
+
+
+def _compare_with_plain_forms(element, d, nonlinear, mesh, nz):
     n_el = 11
     X, Hb, H = _geometry(n_el, seed=4) if mesh == "distorted" else _flat(n_el)
     sheets = (("bars x", _CubicSheet(200000.0, 5e7), 0.04, 0.003, 0.0, (1.0, 0.0, 0.0)),
               ("bars 30", _CubicSheet(200000.0, -3e7), 0.15, 0.002, 30.0, None))
-    blk = inelastic_block(X, Hb, H, d, MAT, _CubicBulk(MAT, 4e6, 3e5), sheets, 3, element)
+    blk = inelastic_block(X, Hb, H, d, MAT, _CubicBulk(MAT, 4e6, 3e5), sheets, nz, element)
     if element == "mitc":  # the tie correction: exercised on the distorted mesh, round-off on the flat one
         v = np.abs(blk.base.v).max()
         assert (v > 1e-3) if mesh == "distorted" else (v < 1e-12)
