@@ -296,8 +296,8 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
     ``sl`` (a contiguous range) from their nodal vectors ``U (e, a, 3)`` and the committed state
     of the whole block; with ``implex`` (:func:`extrapolated_state`) the bulk law's stress takes
     the damage of the extrapolated histories (IMPL-EX). ``fast``: the bulk through the compiled
-    kernel (:mod:`.inelastic_kernel`) and the sheets as batched products, else both through their
-    plain NumPy forms (the independent check)."""
+    kernel (:mod:`.inelastic_kernel`, the sheets' points as further rows of its products), else
+    both through their plain NumPy forms (the independent check)."""
     lo, hi, _ = sl.indices(block.h_in.shape[0])
     sl = slice(lo, hi)
     if block.law is None or not fast:
@@ -305,17 +305,18 @@ def inelastic_response(block: InelasticBlock, U: np.ndarray, nonlinear: bool, ta
     from .inelastic_kernel import bulk_response
 
     stress, out = _bulk_stress(block, sl, committed, implex, tangent)
-    terms = [sheet_terms(s, U, nonlinear, tangent, sl, committed.sheets[k].take(slice(lo * s.w.shape[1],
-                                                                                        hi * s.w.shape[1])))
-             for k, s in enumerate(block.sheets)]
+    terms = []
+    for k, s in enumerate(block.sheets):
+        q = s.w.shape[1]
+        terms.append(sheet_terms(s, U, nonlinear, tangent, sl, committed.sheets[k].take(slice(lo * q, hi * q))))
     f, K = bulk_response(block.base, U, nonlinear, tangent, sl, stress, tuple(t[0] for t in terms))
     return f, K, LayerState(out["trial"], tuple(t[1][0] for t in terms), out["strain"],
                             tuple(t[1][1] for t in terms), tuple(t[1][2] for t in terms))
 
 
 def _bulk_stress(block: InelasticBlock, sl: slice, committed: LayerState, implex, tangent: bool):
-    """The bulk law as ``stress(E) -> (S, D)`` over the elements ``sl`` (:func:`.inelastic_kernel.bulk_response`),
-    and the dict its strain and trial state are left in."""
+    """The bulk law as ``stress(E) -> (S, D)`` over the elements ``sl``
+    (:func:`.inelastic_kernel.bulk_response`), and the dict its strain and trial state are left in."""
     lo, hi = sl.start, sl.stop
     P = block.n_points
     c = committed.bulk.take(slice(lo * P, hi * P))
