@@ -125,6 +125,26 @@ def test_fibre_defaults_and_bad_input():
             SteelLaw(**kw).check()
 
 
+
+def test_grade_and_fibre_defaults_take_any_overridden_constant():
+    """A grade or fibre gives the defaults; any constant given beside it replaces its default, in
+    the model's units. A mean yield strength moves the hardening slope with it: the grade's
+    characteristic ratio k = f_t/f_y is kept, E_h = (k - 1) f_y / (eps_u - f_y/E) (EN 1992-1-1 C.1)."""
+    s = SteelLaw.from_grade("B500B", stress_unit=1.0, f_y=550.0)
+    k, eps_uk = 1.08, 0.05
+    assert (s.E, s.f_y, s.eps_u) == (200e3, 550.0, eps_uk)
+    assert s.f_y + s.E_h * (s.eps_u - s.f_y / s.E) == pytest.approx(k * 550.0, rel=1e-12)
+    assert SteelLaw.from_grade("B500B", E_h=0.0).E_h == 0.0
+    t = TextileLaw.from_fibre("AR-glass", stress_unit=1.0, E=76000.0)
+    assert (t.E, t.f_t) == (76000.0, 1000.0)
+    # the same through a model file's table, in kN and mm
+    from layershell.io.build import _law  # noqa: PLC0415
+    from layershell.io.schema import SteelMat, TextileMat  # noqa: PLC0415
+    law = _law("b", SteelMat(type="steel", grade="B500B", f_y=0.55), "kN, mm")
+    glass = _law("g", TextileMat(type="textile", fibre="AR-glass", E=76.0), "kN, mm")
+    assert glass.E == 76.0 and glass.f_t == pytest.approx(1.0)
+    assert law.f_y == 0.55 and law.E == pytest.approx(200.0)
+
 # -- consistent tangents ----------------------------------------------------------------------------
 
 def _fd_check(law, eps, committed, branch):

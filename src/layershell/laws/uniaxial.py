@@ -39,17 +39,22 @@ class SteelLaw:
     name: str = "steel"
 
     @classmethod
-    def from_grade(cls, grade: str = "B500B", stress_unit: float = 1.0, name: str | None = None) -> "SteelLaw":
+    def from_grade(cls, grade: str = "B500B", stress_unit: float = 1.0, name: str | None = None,
+                   **overrides) -> "SteelLaw":
         """EN 1992-1-1 Annex C grade: f_yk = 500 MPa, E = 200 GPa, hardening from the characteristic
-        k and eps_uk (E_h = (k - 1) f_yk / (eps_uk - f_yk/E)). Characteristic, not mean, values:
-        a mean yield strength (about 1.1 f_yk) must be given explicitly. ``stress_unit``: MPa per
-        model stress unit."""
+        k and eps_uk (E_h = (k - 1) f_y / (eps_u - f_y/E), with the f_y, E and eps_u in use).
+        Characteristic, not mean, values: a mean yield strength (about 1.1 f_yk) must be given
+        explicitly. ``stress_unit``: MPa per model stress unit; ``overrides`` (model units) replace
+        any field."""
         if grade not in STEEL_GRADES:
             raise MaterialError(f"steel grade '{grade}' is not known; use one of {', '.join(STEEL_GRADES)}")
         k, eps_uk = STEEL_GRADES[grade]
-        E, f_y = 200e3, 500.0
-        E_h = (k - 1.0) * f_y / (eps_uk - f_y / E)
-        law = cls(E / stress_unit, f_y / stress_unit, E_h / stress_unit, eps_uk, name or grade)
+        E = overrides.pop("E", 200e3 / stress_unit)
+        f_y = overrides.pop("f_y", 500.0 / stress_unit)
+        eps_u = overrides.pop("eps_u", eps_uk)
+        if "E_h" not in overrides and E > 0 and f_y > 0 and eps_u is not None and eps_u > f_y / E:
+            overrides["E_h"] = (k - 1.0) * f_y / (eps_u - f_y / E)
+        law = cls(E=E, f_y=f_y, eps_u=eps_u, name=name or grade, **overrides)
         law.check()
         return law
 
@@ -136,13 +141,15 @@ class TextileLaw:
     name: str = "textile"
 
     @classmethod
-    def from_fibre(cls, fibre: str = "carbon", stress_unit: float = 1.0, name: str | None = None) -> "TextileLaw":
+    def from_fibre(cls, fibre: str = "carbon", stress_unit: float = 1.0, name: str | None = None,
+                   **overrides) -> "TextileLaw":
         """Typical values (``FIBRES``; take the producer's data where known). ``stress_unit``: MPa per
-        model stress unit."""
+        model stress unit; ``overrides`` (model units) replace any field."""
         if fibre not in FIBRES:
             raise MaterialError(f"textile fibre '{fibre}' is not known; use one of {', '.join(FIBRES)}")
         E, f_t = FIBRES[fibre]
-        law = cls(E / stress_unit, f_t / stress_unit, name=name or fibre)
+        vals = {"E": E / stress_unit, "f_t": f_t / stress_unit, "name": name or fibre, **overrides}
+        law = cls(**vals)
         law.check()
         return law
 
