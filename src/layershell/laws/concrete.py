@@ -43,8 +43,8 @@ KAPPA_TC = 0.8  # tension-compression slope of Kupfer & Gerstle (1973), J. Eng. 
 MC2010_EPS_C1 = ((12, 1.8), (16, 1.9), (20, 2.1), (25, 2.2), (30, 2.3), (35, 2.3), (40, 2.4), (45, 2.5),
                  (50, 2.6), (55, 2.6), (60, 2.7), (70, 2.7), (80, 2.8), (90, 2.8), (100, 3.0), (120, 3.0))
 #: the largest damage an IMPL-EX step acts with: a residual stiffness of 10⁻⁶ E keeps the tangent of
-#: a fully opened crack regular (the implicit state itself goes on to d = 1); 10⁻⁴ E would carry
-#: the TRC strip past its stop at 6.2 mm, but leaves a separated plain beam 5 % of its peak load
+#: a fully opened crack regular (the implicit state itself goes on to d = 1); a lasting 10⁻⁴ E would
+#: leave a separated plain beam 5 % of its peak load (INCREMENT_STIFFNESS acts within an increment)
 MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
 #: within an increment a damaged point keeps INCREMENT_STIFFNESS d_n C0 on the strain change since
 #: the last commit (d_n its committed damage): it fixes the strain modes that an opened crack leaves
@@ -79,6 +79,21 @@ def _x_minus_log1p_rest(x):
     return np.where(small, series, exact)
 
 
+def crack_shear_projector(normal) -> np.ndarray:
+    """Q_n (n, 6, 6): stress-like Voigt A ↦ the Voigt form of (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n,
+    the shear traction of A on the plane with the unit normal ``normal`` (n, 3), as a symmetric tensor."""
+    nv = np.asarray(normal, float)
+    basis = np.zeros((6, 3, 3))  # the tensor of each Voigt component (shears on both entries)
+    for a, (i, j) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
+        basis[a, i, j] = basis[a, j, i] = 1.0
+    t = np.einsum("bij,nj->nbi", basis, nv)
+    a_nn = np.einsum("nbi,ni->nb", t, nv)
+    S = (np.einsum("nbi,nj->nbij", t, nv) + np.einsum("ni,nbj->nbij", nv, t)
+         - 2.0 * np.einsum("nb,ni,nj->nbij", a_nn, nv, nv))
+    rows, cols = [0, 1, 2, 1, 0, 0], [0, 1, 2, 2, 2, 1]
+    return S[:, :, rows, cols].transpose(0, 2, 1)
+
+
 @dataclass(frozen=True)
 class ConcreteLaw:
     """Damage law of plain concrete (module docstring); SI-consistent model units throughout."""
@@ -91,6 +106,10 @@ class ConcreteLaw:
     G_c: float
     eps_c1: float
     k_b: float = 1.16
+    #: β, the fraction of the shear modulus an open crack keeps across its plane (aggregate
+    #: interlock, as the constant shear retention of fixed smeared cracks); 0: none beyond the
+    #: split's own, since 0.2 locks the stress of a separating plain beam (docs/concrete.md, limits)
+    shear_retention: float = 0.0
     name: str = "concrete"
 
     # -- construction --------------------------------------------------------------------------
@@ -134,6 +153,9 @@ class ConcreteLaw:
             raise MaterialError(f"concrete '{self.name}': eps_c1={self.eps_c1} must exceed f_c/E="
                                 f"{self.f_c / self.E:.4g} (no hardening branch below the peak otherwise); "
                                 "raise eps_c1 (about 0.002-0.003) or E")
+        if not 0.0 <= self.shear_retention <= 1.0:
+            raise MaterialError(f"concrete '{self.name}': shear_retention={self.shear_retention} must lie in "
+                                "[0, 1] (the fraction of the shear modulus an open crack keeps); 0 keeps none")
         if not self.k_b >= 1.0:
             raise MaterialError(f"concrete '{self.name}': k_b={self.k_b} (biaxial/uniaxial compressive "
                                 "strength) must be at least 1; Kupfer's value is 1.16")
@@ -246,7 +268,7 @@ class ConcreteLaw:
         if implex is not None:
             out = self._implex(u, committed, tangent, implex)
         else:
-            out = self._implicit(u, tangent)
+            out = self._implicit(u, committed, tangent)
         if strain_n is None:
             return out
         ds, k = self.increment_stress(np.atleast_2d(np.asarray(eps, float)) - strain_n, committed)
@@ -261,16 +283,45 @@ class ConcreteLaw:
         k = INCREMENT_STIFFNESS * np.maximum(np.where(committed.h_t > 0, d_t, 0.0), d_c)
         return k[:, None] * (np.asarray(deps, float) @ self.stiffness()), k
 
-    def _implicit(self, u, tangent: bool):
+    def _implicit(self, u, committed, tangent: bool):
         """The implicit response at the update ``u`` (:meth:`_update`): stress, tangent with the
         damage's variation (or None) and the trial state."""
         s = (1.0 - u.d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - u.d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
+        ds, dD = self._retention(u, committed, u.d_t, tangent, variation=True)
         if not tangent:
-            return sigma, None, u.trial
+            return sigma + ds, None, u.trial
         e_t = np.zeros((u.w.shape[0], 6))
         e_t[u.on] = u.ddt_h[u.on, None] * u.dh_row
-        return sigma, self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t), u.trial
+        return sigma + ds, self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t) + dD, u.trial
+
+    def _retention(self, u, committed, d_t, tangent: bool, variation: bool):
+        """The shear an open crack retains, β d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None:
+        Q_n(A) = (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n, the shear traction of σ̄⁺ on the plane
+        of the committed crack normal n (zero where the committed state is uncracked, and where the
+        crack is closed: σ̄⁺ = 0); β = ``shear_retention``. ``variation``: the tangent adds
+        β Q_n(σ̄⁺) ⊗ dd⁺/dε (the implicit update), else d⁺ is frozen (IMPL-EX)."""
+        n = u.w.shape[0]
+        cracked = np.flatnonzero(committed.h_t > 0) if self.shear_retention > 0 else np.zeros(0, int)
+        ds = np.zeros((n, 6))
+        dD = np.zeros((n, 6, 6)) if tangent else None
+        if cracked.size == 0:
+            return ds, dD
+        nv = np.stack([committed.n1, committed.n2, committed.n3], -1)[cracked]
+        Q = crack_shear_projector(nv)
+        sp = np.einsum("nk,nka->na", np.maximum(u.w[cracked], 0.0), u.P[cracked])
+        qs = np.einsum("nab,nb->na", Q, sp)
+        bd = self.shear_retention * d_t[cracked]
+        ds[cracked] = bd[:, None] * qs
+        if tangent:
+            sub = SimpleNamespace(V=u.V[cracked], w=u.w[cracked], P=u.P[cracked], sbar=u.sbar[cracked])
+            m = cracked.size
+            dpos = self._tangent(sub, np.zeros(m), np.ones(m), False)  # dσ̄⁺/dε
+            dD[cracked] = bd[:, None, None] * np.einsum("nab,nbc->nac", Q, dpos)
+            if variation:
+                row = np.einsum("nk,nka->na", u.g_t[cracked], u.P[cracked]) * spectral.WEIGHT
+                dD[cracked] += self.shear_retention * qs[:, :, None] * (row @ self.stiffness())[:, None, :]
+        return ds, dD
 
     def _update(self, eps, committed: ConcreteState, h_in, h_z, normal) -> SimpleNamespace:
         """The implicit update at the strains ``eps``: the trial state (``trial``), the effective
@@ -349,9 +400,10 @@ class ConcreteLaw:
         d_t, d_c = np.minimum(d_t, MAX_IMPLEX_DAMAGE), np.minimum(d_c, MAX_IMPLEX_DAMAGE)
         s = (1.0 - d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
+        ds, dD = self._retention(u, committed, d_t, tangent, variation=False)
         if not tangent:
-            return sigma, None, u.trial
-        return sigma, self._tangent(u, d_t, d_c, False), u.trial
+            return sigma + ds, None, u.trial
+        return sigma + ds, self._tangent(u, d_t, d_c, False) + dD, u.trial
 
     # -- post-processing ------------------------------------------------------------------------
     def events(self, state: ConcreteState) -> dict[str, np.ndarray]:
