@@ -62,13 +62,14 @@ def softening_work(law, h, steps, increment=True):
 
 @pytest.mark.parametrize("h", [10.0, 50.0, 150.0])
 def test_fracture_energy_with_the_increment_stiffness_and_its_error_against_the_steps(h):
-    """Uniaxial tension with the increment stiffness on every step dissipates G_F per crack area
-    within 1 % for three bands; the work it adds, k d E Δε per step, halves as the steps halve."""
+    """Uniaxial tension with the increment stiffness on every step: the work it adds, k d E Δε per
+    step, halves as the steps halve (first order), and the work extrapolated to vanishing steps,
+    2 W(2m) − W(m), is G_F per crack area within 1 % for three bands."""
     law = C30
     work = {m: softening_work(law, h, m) for m in (1000, 2000, 4000)}
-    np.testing.assert_allclose(work[4000][0] * h, law.G_F, rtol=0.01)
     np.testing.assert_allclose(work[4000][1] * h, law.G_F, rtol=0.01)  # the law's own dissipation
     extra = {m: (w[0] - softening_work(law, h, m, False)[0]) * h / law.G_F for m, w in work.items()}
-    assert 0 < extra[1000] < 0.01
+    assert 0 < extra[1000] < 100 * concrete.INCREMENT_STIFFNESS
     assert extra[2000] / extra[1000] == pytest.approx(0.5, rel=0.02)
     assert extra[4000] / extra[2000] == pytest.approx(0.5, rel=0.02)
+    np.testing.assert_allclose((2 * work[4000][0] - work[2000][0]) * h, law.G_F, rtol=0.01)
