@@ -25,6 +25,13 @@ Crack band: fixed when a point first cracks, h = h_in sin θ + h_z |cos θ| with
 normal (principal direction of σ̄_max at onset) and the shell normal. Crushing uses h_in: it
 localises across an in-plane element length (compression normal to the mid-surface is not a
 shell's failure mode).
+
+Optional shear retention (``shear_retention`` = β, default 0): an open crack keeps β μ across the
+plane of its fixed normal n, σ += β d⁺ Q_n(σ̄⁺) (:func:`crack_shear_projector`). Increment stiffness
+(``strain_n`` given, as by the layer elements): σ += k d_n C0 (ε − ε_n) with the committed strain
+ε_n and damage d_n, k = :data:`INCREMENT_STIFFNESS`: an opened crack makes all three principal
+effective stresses positive (the Poisson part of its strain), so d⁺ → 1 leaves no stiffness in
+any strain mode; this term holds such modes within an increment.
 """
 from __future__ import annotations
 
