@@ -296,25 +296,29 @@ class ConcreteLaw:
         damage's variation (or None) and the trial state."""
         s = (1.0 - u.d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - u.d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
-        ds, dD = self._retention(u, committed, u.d_t, tangent, variation=True)
+        ret = self._retention(u, committed, u.d_t, tangent, variation=True)
+        if ret is not None:
+            sigma = sigma + ret[0]
         if not tangent:
-            return sigma + ds, None, u.trial
+            return sigma, None, u.trial
         e_t = np.zeros((u.w.shape[0], 6))
         e_t[u.on] = u.ddt_h[u.on, None] * u.dh_row
-        return sigma + ds, self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t) + dD, u.trial
+        D = self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t)
+        return sigma, (D if ret is None else D + ret[1]), u.trial
 
     def _retention(self, u, committed, d_t, tangent: bool, variation: bool):
-        """The shear an open crack retains, β d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None:
+        """The shear an open crack retains, β d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None
+        (tangent False); None where no point retains any (β = 0 or no committed crack):
         Q_n(A) = (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n, the shear traction of σ̄⁺ on the plane
         of the committed crack normal n (zero where the committed state is uncracked, and where the
         crack is closed: σ̄⁺ = 0); β = ``shear_retention``. ``variation``: the tangent adds
         β Q_n(σ̄⁺) ⊗ dd⁺/dε (the implicit update), else d⁺ is frozen (IMPL-EX)."""
-        n = u.w.shape[0]
         cracked = np.flatnonzero(committed.h_t > 0) if self.shear_retention > 0 else np.zeros(0, int)
+        if cracked.size == 0:
+            return None
+        n = u.w.shape[0]
         ds = np.zeros((n, 6))
         dD = np.zeros((n, 6, 6)) if tangent else None
-        if cracked.size == 0:
-            return ds, dD
         nv = np.stack([committed.n1, committed.n2, committed.n3], -1)[cracked]
         Q = crack_shear_projector(nv)
         sp = np.einsum("nk,nka->na", np.maximum(u.w[cracked], 0.0), u.P[cracked])
@@ -408,10 +412,13 @@ class ConcreteLaw:
         d_t, d_c = np.minimum(d_t, MAX_IMPLEX_DAMAGE), np.minimum(d_c, MAX_IMPLEX_DAMAGE)
         s = (1.0 - d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
-        ds, dD = self._retention(u, committed, d_t, tangent, variation=False)
+        ret = self._retention(u, committed, d_t, tangent, variation=False)
+        if ret is not None:
+            sigma = sigma + ret[0]
         if not tangent:
-            return sigma + ds, None, u.trial
-        return sigma + ds, self._tangent(u, d_t, d_c, False) + dD, u.trial
+            return sigma, None, u.trial
+        D = self._tangent(u, d_t, d_c, False)
+        return sigma, (D if ret is None else D + ret[1]), u.trial
 
     # -- post-processing ------------------------------------------------------------------------
     def events(self, state: ConcreteState) -> dict[str, np.ndarray]:
