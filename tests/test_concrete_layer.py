@@ -169,6 +169,8 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('strength_class = "C30/37"', 'f_c = 38.0'), "materials.c30", "missing: E, f_ct, G_F, G_c, eps_c1"),
     (('height = 30.0', 'height = 160.0'), "reinforcement[0].height", "160 thick"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "units"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nshear_retention = 1.5'), "materials.c30",
+     "shear_retention=1.5 must lie in [0, 1]"),
 ])
 def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
     text = strip_model(6, 4)

@@ -321,6 +321,8 @@ def _bulk_stress(block: InelasticBlock, sl: slice, committed: LayerState, implex
     P = block.n_points
     c = committed.bulk.take(slice(lo * P, hi * P))
     extra = {} if implex is None else {"implex": implex.bulk.take(slice(lo * P, hi * P))}
+    if committed.strain is not None:  # the increment stiffness acts on the change since the commit
+        extra["strain_n"] = committed.strain[lo * P:hi * P]
     out = {}
 
     def stress(E):

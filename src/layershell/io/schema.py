@@ -321,6 +321,8 @@ class ConcreteMat(Strict):
     G_F: PositiveFloat | None = Field(None, description="tensile fracture energy (force/length); default fib MC2010")
     G_c: PositiveFloat | None = Field(None, description="compressive fracture energy (force/length)")
     eps_c1: PositiveFloat | None = Field(None, description="strain at the compressive peak, positive")
+    shear_retention: float | None = Field(None, description=(
+        "fraction 0..1 of the shear modulus an open crack keeps across its plane; default 0"))
     density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
     @model_validator(mode="after")

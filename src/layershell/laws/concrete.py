@@ -25,6 +25,13 @@ Crack band: fixed when a point first cracks, h = h_in sin θ + h_z |cos θ| with
 normal (principal direction of σ̄_max at onset) and the shell normal. Crushing uses h_in: it
 localises across an in-plane element length (compression normal to the mid-surface is not a
 shell's failure mode).
+
+Optional shear retention (``shear_retention`` = β, default 0): an open crack keeps β μ across the
+plane of its fixed normal n, σ += β d⁺ Q_n(σ̄⁺) (:func:`crack_shear_projector`). Increment stiffness
+(``strain_n`` given, as by the layer elements): σ += k d_n C0 (ε − ε_n) with the committed strain
+ε_n and damage d_n, k = :data:`INCREMENT_STIFFNESS`: an opened crack makes all three principal
+effective stresses positive (the Poisson part of its strain), so d⁺ → 1 leaves no stiffness in
+any strain mode; this term holds such modes within an increment.
 """
 from __future__ import annotations
 
@@ -43,9 +50,15 @@ KAPPA_TC = 0.8  # tension-compression slope of Kupfer & Gerstle (1973), J. Eng. 
 MC2010_EPS_C1 = ((12, 1.8), (16, 1.9), (20, 2.1), (25, 2.2), (30, 2.3), (35, 2.3), (40, 2.4), (45, 2.5),
                  (50, 2.6), (55, 2.6), (60, 2.7), (70, 2.7), (80, 2.8), (90, 2.8), (100, 3.0), (120, 3.0))
 #: the largest damage an IMPL-EX step acts with: a residual stiffness of 10⁻⁶ E keeps the tangent of
-#: a fully opened crack regular (the implicit state itself goes on to d = 1); 10⁻⁴ E would carry
-#: the TRC strip past its stop at 6.2 mm, but leaves a separated plain beam 5 % of its peak load
+#: a fully opened crack regular (the implicit state itself goes on to d = 1); a lasting 10⁻⁴ E would
+#: leave a separated plain beam 5 % of its peak load (INCREMENT_STIFFNESS acts within an increment)
 MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
+#: within an increment a damaged point keeps INCREMENT_STIFFNESS d_n C0 on the strain change since
+#: the last commit (d_n its committed damage): it holds the strain modes that an opened crack leaves
+#: without stiffness where the increment does not move them; its stress, INCREMENT_STIFFNESS E Δε, goes
+#: with the increment Δε. 3·10⁻⁴: the TRC strip on 62.5 mm elements needs more than 10⁻⁴, and 10⁻³
+#: leaves the separated plain beam on 12 mm elements 1.2 % of its peak load (docs/concrete.md)
+INCREMENT_STIFFNESS = 3e-4
 NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
 
 
@@ -74,6 +87,21 @@ def _x_minus_log1p_rest(x):
     return np.where(small, series, exact)
 
 
+def crack_shear_projector(normal) -> np.ndarray:
+    """Q_n (n, 6, 6): stress-like Voigt A ↦ the Voigt form of (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n,
+    the shear traction of A on the plane with the unit normal ``normal`` (n, 3), as a symmetric tensor."""
+    nv = np.asarray(normal, float)
+    basis = np.zeros((6, 3, 3))  # the tensor of each Voigt component (shears on both entries)
+    for a, (i, j) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
+        basis[a, i, j] = basis[a, j, i] = 1.0
+    t = np.einsum("bij,nj->nbi", basis, nv)
+    a_nn = np.einsum("nbi,ni->nb", t, nv)
+    S = (np.einsum("nbi,nj->nbij", t, nv) + np.einsum("ni,nbj->nbij", nv, t)
+         - 2.0 * np.einsum("nb,ni,nj->nbij", a_nn, nv, nv))
+    rows, cols = [0, 1, 2, 1, 0, 0], [0, 1, 2, 2, 2, 1]
+    return S[:, :, rows, cols].transpose(0, 2, 1)
+
+
 @dataclass(frozen=True)
 class ConcreteLaw:
     """Damage law of plain concrete (module docstring); SI-consistent model units throughout."""
@@ -86,6 +114,10 @@ class ConcreteLaw:
     G_c: float
     eps_c1: float
     k_b: float = 1.16
+    #: β, the fraction of the shear modulus an open crack keeps across its plane (aggregate
+    #: interlock, as the constant shear retention of fixed smeared cracks); 0: none beyond the
+    #: split's own, since 0.2 locks the stress of a separating plain beam (docs/concrete.md, limits)
+    shear_retention: float = 0.0
     name: str = "concrete"
 
     # -- construction --------------------------------------------------------------------------
@@ -129,6 +161,9 @@ class ConcreteLaw:
             raise MaterialError(f"concrete '{self.name}': eps_c1={self.eps_c1} must exceed f_c/E="
                                 f"{self.f_c / self.E:.4g} (no hardening branch below the peak otherwise); "
                                 "raise eps_c1 (about 0.002-0.003) or E")
+        if not 0.0 <= self.shear_retention <= 1.0:
+            raise MaterialError(f"concrete '{self.name}': shear_retention={self.shear_retention} must lie in "
+                                "[0, 1] (the fraction of the shear modulus an open crack keeps); 0 keeps none")
         if not self.k_b >= 1.0:
             raise MaterialError(f"concrete '{self.name}': k_b={self.k_b} (biaxial/uniaxial compressive "
                                 "strength) must be at least 1; Kupfer's value is 1.16")
@@ -226,25 +261,79 @@ class ConcreteLaw:
         return h, v, dh_dc[:, None] * spectral.eigvec_derivative_row(V, w, 2, normal)
 
     def response(self, eps, committed: ConcreteState, h_in, h_z, normal, tangent: bool = True,
-                 implex: ConcreteState | None = None):
+                 implex: ConcreteState | None = None, strain_n=None):
         """Stress (n, 6), consistent tangent dσ/dε (n, 6, 6) or None, and the trial state.
 
         ``eps`` (n, 6) Voigt strains with engineering shears; ``h_in``, ``h_z`` (n,) element size and
         thickness-point spacing; ``normal`` (n, 3) unit shell normal. ``committed`` is not modified.
         ``implex``: the histories extrapolated to this step (IMPL-EX, Oliver, Huespe & Cante 2008):
         stress and tangent take the damage of its r_t, r_c (bands of ``committed``) at frozen damage;
-        the trial state is the implicit update as without it.
+        the trial state is the implicit update as without it. ``strain_n`` (n, 6): the strains of
+        ``committed``; with it the stress adds the increment stiffness k d_n C0 (ε − ε_n)
+        (:data:`INCREMENT_STIFFNESS`, :meth:`increment_stress`).
         """
         u = self._update(eps, committed, h_in, h_z, normal)
         if implex is not None:
-            return self._implex(u, committed, tangent, implex)
+            out = self._implex(u, committed, tangent, implex)
+        else:
+            out = self._implicit(u, committed, tangent)
+        if strain_n is None:
+            return out
+        ds, k = self.increment_stress(np.atleast_2d(np.asarray(eps, float)) - strain_n, committed)
+        return out[0] + ds, (None if out[1] is None else out[1] + k[:, None, None] * self.stiffness()), out[2]
+
+    def increment_stress(self, deps, committed: ConcreteState):
+        """The increment stiffness's stress k d_n C0 Δε (n, 6) of the strain change ``deps`` since the
+        commit, and its factor k d_n (n,): d_n = max(d⁺, d⁻) of ``committed``, k =
+        :data:`INCREMENT_STIFFNESS` (0 at undamaged points; constant within an increment)."""
+        d_t, _, _ = self.damage_tension(committed.r_t, committed.h_t)
+        d_c, _ = self.damage_compression(committed.r_c, committed.h_c)
+        k = INCREMENT_STIFFNESS * np.maximum(np.where(committed.h_t > 0, d_t, 0.0), d_c)
+        return k[:, None] * (np.asarray(deps, float) @ self.stiffness()), k
+
+    def _implicit(self, u, committed, tangent: bool):
+        """The implicit response at the update ``u`` (:meth:`_update`): stress, tangent with the
+        damage's variation (or None) and the trial state."""
         s = (1.0 - u.d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - u.d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
+        ret = self._retention(u, committed, u.d_t, tangent, variation=True)
+        if ret is not None:
+            sigma = sigma + ret[0]
         if not tangent:
             return sigma, None, u.trial
         e_t = np.zeros((u.w.shape[0], 6))
         e_t[u.on] = u.ddt_h[u.on, None] * u.dh_row
-        return sigma, self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t), u.trial
+        D = self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t)
+        return sigma, (D if ret is None else D + ret[1]), u.trial
+
+    def _retention(self, u, committed, d_t, tangent: bool, variation: bool):
+        """The shear an open crack retains, β d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None
+        (tangent False); None where no point retains any (β = 0 or no committed crack):
+        Q_n(A) = (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n, the shear traction of σ̄⁺ on the plane
+        of the committed crack normal n (zero where the committed state is uncracked, and where the
+        crack is closed: σ̄⁺ = 0); β = ``shear_retention``. ``variation``: the tangent adds
+        β Q_n(σ̄⁺) ⊗ dd⁺/dε (the implicit update), else d⁺ is frozen (IMPL-EX)."""
+        cracked = np.flatnonzero(committed.h_t > 0) if self.shear_retention > 0 else np.zeros(0, int)
+        if cracked.size == 0:
+            return None
+        n = u.w.shape[0]
+        ds = np.zeros((n, 6))
+        dD = np.zeros((n, 6, 6)) if tangent else None
+        nv = np.stack([committed.n1, committed.n2, committed.n3], -1)[cracked]
+        Q = crack_shear_projector(nv)
+        sp = np.einsum("nk,nka->na", np.maximum(u.w[cracked], 0.0), u.P[cracked])
+        qs = np.einsum("nab,nb->na", Q, sp)
+        bd = self.shear_retention * d_t[cracked]
+        ds[cracked] = bd[:, None] * qs
+        if tangent:
+            sub = SimpleNamespace(V=u.V[cracked], w=u.w[cracked], P=u.P[cracked], sbar=u.sbar[cracked])
+            m = cracked.size
+            dpos = self._tangent(sub, np.zeros(m), np.ones(m), False)  # dσ̄⁺/dε
+            dD[cracked] = bd[:, None, None] * np.einsum("nab,nbc->nac", Q, dpos)
+            if variation:
+                row = np.einsum("nk,nka->na", u.g_t[cracked], u.P[cracked]) * spectral.WEIGHT
+                dD[cracked] += self.shear_retention * qs[:, :, None] * (row @ self.stiffness())[:, None, :]
+        return ds, dD
 
     def _update(self, eps, committed: ConcreteState, h_in, h_z, normal) -> SimpleNamespace:
         """The implicit update at the strains ``eps``: the trial state (``trial``), the effective
@@ -323,9 +412,13 @@ class ConcreteLaw:
         d_t, d_c = np.minimum(d_t, MAX_IMPLEX_DAMAGE), np.minimum(d_c, MAX_IMPLEX_DAMAGE)
         s = (1.0 - d_t)[:, None] * np.maximum(u.w, 0.0) + (1.0 - d_c)[:, None] * np.minimum(u.w, 0.0)
         sigma = np.einsum("nk,nka->na", s, u.P)
+        ret = self._retention(u, committed, d_t, tangent, variation=False)
+        if ret is not None:
+            sigma = sigma + ret[0]
         if not tangent:
             return sigma, None, u.trial
-        return sigma, self._tangent(u, d_t, d_c, False), u.trial
+        D = self._tangent(u, d_t, d_c, False)
+        return sigma, (D if ret is None else D + ret[1]), u.trial
 
     # -- post-processing ------------------------------------------------------------------------
     def events(self, state: ConcreteState) -> dict[str, np.ndarray]:
