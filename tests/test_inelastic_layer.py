@@ -32,8 +32,9 @@ class _CubicBulk:
     def state(self, n):
         return _Hist(np.zeros(n))
 
-    def response(self, eps, committed, h_in, h_z, normal, tangent=True):
+    def response(self, eps, committed, h_in, h_z, normal, tangent=True, strain_n=None):
         assert eps.shape[0] == h_in.shape[0] == h_z.shape[0] == normal.shape[0]
+        assert strain_n is None or strain_n.shape == eps.shape  # the committed strain, for laws that use it
         e2 = np.einsum("pv,pv->p", eps, eps)
         ae = eps @ self.a
         S = eps @ self.C.T + (self.beta * e2 + self.gamma * ae)[:, None] * eps
