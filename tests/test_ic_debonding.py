@@ -49,10 +49,12 @@ def lapshear_with_damage_probe(factors: list[float]) -> str:
 
 
 def test_interface_damage_probe_finds_the_onset_of_the_lap_shear_closed_form(tmp_path):
-    """Below the closed-form onset load (loaded-end slip δ_1) no point is damaged; 3 % above it
-    the loaded end is past the peak, and the probe reads the blocks' largest damage."""
+    """5 % below the closed-form onset load (loaded-end slip δ_1) no point is damaged; 5 % above it
+    the loaded end is past the peak (the FE onset lies between 1.01 and 1.02 of the closed form:
+    the slip is taken on the plate's bottom face, which the plate's bending moves), and the probe
+    reads the blocks' largest damage."""
     P_on = lapshear_onset_load()
-    res = run(build(parse(lapshear_with_damage_probe([0.97 * P_on / 25000.0, 1.03 * P_on / 25000.0]))),
+    res = run(build(parse(lapshear_with_damage_probe([0.95 * P_on / 25000.0, 1.05 * P_on / 25000.0]))),
               tmp_path, write_vtu=False)
     d = [s["probes"]["d"] for s in res.summary["steps"]]
     assert d[0] == 0.0
