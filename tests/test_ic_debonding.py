@@ -114,6 +114,7 @@ def run_to_onset(h: float, folder) -> dict:
     res = run(build(parse(strip_text(h))), folder, progress=stop, write_vtu=False)
     steps = res.summary["steps"]
     p = {k: np.array([s["probes"][k] for s in steps]) for k in steps[0]["probes"]}
+    p["load_factor"] = np.array([s["load_factor"] for s in steps])
     p["M"] = p["R"] * 1000.0 / h / 1000.0  # kNm/m: the half span's reaction × the 1 m lever arm per metre
     p["onset"] = int(np.argmax(p["damage_f"] > 0.0)) if (p["damage_f"] > 0.0).any() else None
     p["seconds"] = res.summary["wall_seconds"]
