@@ -229,6 +229,8 @@ class _ProbeFloors:
                 out[p.name] = abs(p.scale) * jump_area * self.areas[p.name]
             if p.quantity == "displacement" and u is not None:
                 out[p.name] = abs(p.scale) * self.DISPLACEMENT * largest
+            if p.quantity == "interface_damage":  # bounded by 1: its jumps are a point's state, not the path's
+                out[p.name] = abs(p.scale)
             if p.quantity != "reaction":
                 continue
             if p.name not in self.norms:

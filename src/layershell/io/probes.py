@@ -60,6 +60,14 @@ class Probe:
         ps = self.points(model, dm, u, load_factor)
         return self.scale * component_values(ps, self.quantity, self.component, self.measure, self.frame)
 
+    def _selected(self, blk, values: np.ndarray) -> np.ndarray:
+        """``values`` (e, q) of an interface block's points, False/0 outside ``where``."""
+        if self.where is None:
+            return values
+        X = blk.X0
+        inside = np.asarray(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), bool)
+        return values * np.broadcast_to(inside, values.shape)
+
     def debonded_area(self, interfaces, whole: bool = False) -> float:
         """Released area of the interfaces below ``layer`` (points selected by ``where``);
         ``whole``: the area of all those points, released or not (the area the probe watches)."""
@@ -68,13 +76,24 @@ class Probe:
             blk = r.block
             if blk.itf.upper != self.layer:
                 continue
-            counted = np.ones_like(blk.released) if whole else blk.released
-            if self.where is not None:
-                X = blk.X0
-                inside = np.asarray(self.where(x=X[..., 0], y=X[..., 1], z=X[..., 2]), bool)
-                counted = counted & np.broadcast_to(inside, counted.shape)
+            counted = self._selected(blk, np.ones_like(blk.released) if whole else blk.released)
             area += float((blk.w0 * counted).sum())
         return area
+
+    def interface_damage(self, interfaces) -> float:
+        """The largest committed damage of the interface points below ``layer`` (selected by
+        ``where``): a cohesive law's d (above 0 once a point passed the peak of its law), 0 or 1
+        (released) for the thesis's law."""
+        worst = 0.0
+        for r in interfaces.runs if interfaces is not None else ():
+            blk = r.block
+            if blk.itf.upper != self.layer:
+                continue
+            d = getattr(blk, "d_old", None)
+            d = blk.released.astype(float) if d is None else np.asarray(d, float)
+            if d.size:
+                worst = max(worst, float(self._selected(blk, d).max()))
+        return worst
 
     # ------------------------------------------------------------ reaction
     def rigid_mode(self, model, dm) -> np.ndarray:
@@ -187,6 +206,8 @@ class Probe:
             return self.scale * float(load_factor)
         if self.quantity == "debonded_area":
             return self.scale * self.debonded_area(interfaces)
+        if self.quantity == "interface_damage":
+            return self.scale * self.interface_damage(interfaces)
         if self.quantity in MATERIAL_QUANTITIES:
             return self.scale * self.material_value(model)
         v = self.samples(model, dm, u, load_factor)
@@ -339,7 +360,7 @@ def build_probes(mf, model, layer_index, node_selection) -> list[Probe]:
         if pd.direction is not None or pd.about is not None:
             raise InputError(f"'{f}': 'direction' and 'about' belong to resultant probes; remove them from this "
                              f"{pd.quantity} probe")
-        if pd.quantity in ("debonded_area", "load_factor", *MATERIAL_QUANTITIES):
+        if pd.quantity in ("debonded_area", "interface_damage", "load_factor", *MATERIAL_QUANTITIES):
             out.append(_global_probe(pd, f, k, model, node_selection))
             continue
         comp = pd.component
@@ -511,7 +532,7 @@ def _check_heights(model, f: str, el, xi, eta, th, k: int | None) -> None:
 
 
 def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
-    """A probe of the whole state: the load factor, or a debonded area of an interface."""
+    """A probe of the whole state: the load factor, or a debonded area or the damage of an interface."""
     from .errors import XYZ, InputError
     from .errors import formula as _formula
 
@@ -526,9 +547,9 @@ def _global_probe(pd, f: str, k: int | None, model, node_selection) -> Probe:
         raise InputError(f"'{f}': a {pd.quantity} probe takes no {', '.join(map(repr, extra))}; remove "
                          + ("them" if len(extra) > 1 else "it"))
     where = None
-    if pd.quantity == "debonded_area":
+    if pd.quantity in ("debonded_area", "interface_damage"):
         if k is None:
-            raise InputError(f"'{f}.layer': a debonded_area probe needs the layer above the interface")
+            raise InputError(f"'{f}.layer': a {pd.quantity} probe needs the layer above the interface")
         if k not in model.interface_laws:
             raise InputError(f"'{f}.layer': the interface below '{pd.layer}' has no [[interfaces]] entry, so it "
                              "never debonds; add one or name the layer of an [[interfaces]] entry")

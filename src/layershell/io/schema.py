@@ -731,21 +731,23 @@ class Steps(Strict):
 class ProbeDef(Strict):
     name: str = Field(min_length=1, pattern=r"^[A-Za-z_][A-Za-z0-9_]*$", description=(
         "column name in probes.csv and summary.json"))
-    quantity: Literal["displacement", "stress", "traction", "debonded_area", "load_factor", "reaction",
-                      "resultant", "crack_width", "rebar_stress", "rebar_strain"] = Field(
+    quantity: Literal["displacement", "stress", "traction", "debonded_area", "interface_damage", "load_factor",
+                      "reaction", "resultant", "crack_width", "rebar_stress", "rebar_strain"] = Field(
         description="crack_width, rebar_stress, rebar_strain: over the integration points of the concrete layer / "
                     "the reinforcement of `layer` (component: the reinforcement's name, default all) whose element "
                     "centre satisfies `where`, reduced by `reduce` (default max); "
                     "debonded_area: released area of the interface below `layer` (within `where`, a formula "
-                    "of the interface points' x, y, z); load_factor: λ (× scale, e.g. the load in force units); "
+                    "of the interface points' x, y, z); interface_damage: the largest committed damage (0 intact, "
+                    "1 debonded; past the peak of a cohesive law above 0) of the interface below `layer` (within "
+                    "`where`); load_factor: λ (× scale, e.g. the load in force units); "
                     "reaction: force (component x|y|z) or moment about the origin (mx|my|mz) that the supports "
                     "exert at the selected nodes (where/set/point), R = f_int − F_ext summed over the nodes' "
                     "rigid-body modes; resultant: stress resultant per unit width at `point`, integrated through "
                     "all layers (component n|m|q|nt|mt on the section whose normal is `direction`)")
     point: Vec3 | None = Field(None, description=(
         "displacement: the nearest node; stress, traction: a point on the reference surface"))
-    where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area: "
-                                                "interface points counted")
+    where: str | None = Field(None, description="displacement: node selection (use with reduce); debonded_area, "
+                                                "interface_damage: interface points counted")
     set: str | None = Field(None, description="displacement: " + _SET_N)
     component: str | None = Field(
         None, description="displacement: x|y|z|magnitude; stress: 11|22|33|23|13|12|p1|p2|p3|von_mises; "
@@ -765,7 +767,8 @@ class ProbeDef(Strict):
     theta3: Union[float, Annotated[list[float], Field(min_length=3, max_length=3)]] = Field(
         0.0, description="Θ³ from the reference face, or [start, end, n] to sample (with reduce)")
     layer: str | None = Field(None, description=(
-        "the layer meant (where theta3 lies on a layer boundary); traction and debonded_area: the layer above the "
+        "the layer meant (where theta3 lies on a layer boundary); traction, debonded_area and interface_damage: the "
+        "layer above the "
         "interface; reaction: only the force on that layer at the nodes (default: all layers). Displacement, "
         "stress and traction probes must lie where the layer exists ([[stacks]]); a point on the end of the "
         "layer reads an element that holds it"))
