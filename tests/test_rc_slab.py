@@ -186,14 +186,15 @@ def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
 @pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")
 @pytest.mark.parametrize("n, p_fail", [(6, 9.43), (9, 7.97)])
 def test_a_bare_point_support_fails_earlier_on_finer_meshes(n, p_fail):
-    """Without the bearing plate (the soffit held at one node) the slab fails at its support: the
-    load falls by more than half within one step at p_fail (kN), when the crack in the corner
-    element opens by millimetres while those near the load stay below 0.1 mm. The stresses at
-    a point support are singular: the finer mesh fails earlier, both below the measured 10.8 kN."""
+    """Without the bearing plate (the soffit held at one node) the slab fails at its support: within
+    one step the load falls below 0.6 of its peak p_fail (kN), when the crack in the corner element
+    opens by millimetres (five times its opening a step before) while those near the load stay
+    below 0.1 mm. The stresses at a point support are singular: the finer mesh fails earlier, both
+    below the measured 10.8 kN."""
     w, P, steps = load_deflection({**POINT_SUPPORT, "nx = 6": f"nx = {n}", "ny = 6": f"ny = {n}"})
-    drop = np.nonzero(P[1:] < 0.5 * P[:-1])[0]
+    drop = np.nonzero(P[1:] < 0.6 * np.maximum.accumulate(P)[:-1])[0]
     assert drop.size
     i = drop[0]
     assert P[: i + 1].max() == pytest.approx(p_fail, abs=0.05)
     corner, centre = steps[i]["probes"]["crack_corner"], steps[i]["probes"]["crack_centre"]
-    assert corner > 1.0 and centre < 0.1 and corner > 10 * steps[i - 1]["probes"]["crack_corner"]
+    assert corner > 1.0 and centre < 0.1 and corner > 5 * steps[i - 1]["probes"]["crack_corner"]
