@@ -91,15 +91,11 @@ def crack_shear_projector(normal) -> np.ndarray:
     """Q_n (n, 6, 6): stress-like Voigt A ↦ the Voigt form of (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n,
     the shear traction of A on the plane with the unit normal ``normal`` (n, 3), as a symmetric tensor."""
     nv = np.asarray(normal, float)
-    basis = np.zeros((6, 3, 3))  # the tensor of each Voigt component (shears on both entries)
-    for a, (i, j) in enumerate(((0, 0), (1, 1), (2, 2), (1, 2), (0, 2), (0, 1))):
-        basis[a, i, j] = basis[a, j, i] = 1.0
-    t = np.einsum("bij,nj->nbi", basis, nv)
+    m = nv.shape[0]
+    t = np.einsum("bij,nj->nbi", spectral.to_tensor(np.eye(6)), nv)  # A n of each unit Voigt stress A
     a_nn = np.einsum("nbi,ni->nb", t, nv)
-    S = (np.einsum("nbi,nj->nbij", t, nv) + np.einsum("ni,nbj->nbij", nv, t)
-         - 2.0 * np.einsum("nb,ni,nj->nbij", a_nn, nv, nv))
-    rows, cols = [0, 1, 2, 1, 0, 0], [0, 1, 2, 2, 2, 1]
-    return S[:, :, rows, cols].transpose(0, 2, 1)
+    An_n = spectral.dyad(t.reshape(-1, 3), np.repeat(nv, 6, axis=0)).reshape(m, 6, 6)  # sym((A n) ⊗ n)
+    return (2.0 * An_n - 2.0 * a_nn[:, :, None] * spectral.dyad(nv, nv)[:, None, :]).transpose(0, 2, 1)
 
 
 @dataclass(frozen=True)
@@ -280,6 +276,8 @@ class ConcreteLaw:
         if strain_n is None:
             return out
         ds, k = self.increment_stress(np.atleast_2d(np.asarray(eps, float)) - strain_n, committed)
+        if not k.any():  # no damaged point: the term is zero
+            return out
         return out[0] + ds, (None if out[1] is None else out[1] + k[:, None, None] * self.stiffness()), out[2]
 
     def increment_stress(self, deps, committed: ConcreteState):
