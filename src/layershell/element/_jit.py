@@ -99,7 +99,7 @@ def add_geometric(K, Kg):  # pragma: no cover
 
 @njit(cache=True, nogil=True, fastmath=True)
 def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, d, nonlinear, want_b, want_geo, lower,
-               f, B, GS, GT, mode, sig_in, E_out):  # pragma: no cover
+               f, B, GS, GT, mode, sig_in, E_out, Dg):  # pragma: no cover
     """MITC9 layer kernel per element and thickness level (``mitc.py``), in the tie space: the
     covariant strains E_k and their rows B_k (k = tie (c, t), k = off[c] + t) at the tying points
     (only the frame directions a point is tied in), the tied stresses σ = Ĉ E with the level's
@@ -109,7 +109,9 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
     GS = ∂phi σ, GT = ∂phi (e, columns, a). ``gn, gk, gJ``: for the r-th tied direction K of
     point p, the ties k and the directions J with σ_JK(p) = σ_k. ``mode`` 0: as above; 1: only the
     tie strains, into E_out (e, z, nT) (f gets zeros, nothing else is written); 2: the tie
-    stresses σ given as sig_in (e, z, nT), Lh unused (inelastic layers, :mod:`.inelastic_kernel`)."""
+    stresses σ given as sig_in (e, z, nT), Lh unused, and the displacement derivatives
+    ∂u/∂F_b = Dg (e, z, P, 3, 3) [b, k] given (inelastic layers, :mod:`.inelastic_kernel`, whose
+    strain pass forms them); Dg is unused in modes 0 and 1."""
     ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
     nT = off[6]
     nd = d + 1
@@ -149,14 +151,17 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
                         nn = Nn[p, n] * m2
                         for l in range(nd):
                             dphi[p, b, n * nd + l] = dn * pw[l] + nn * dpw[l]  # derivative of phi_a along F_b
-                    D0 = 0.0
-                    D1 = 0.0
-                    D2 = 0.0
-                    for a in range(na):
-                        v = dphi[p, b, a]
-                        D0 += v * Ut[0, a]
-                        D1 += v * Ut[1, a]
-                        D2 += v * Ut[2, a]
+                    if mode == 2:
+                        D0, D1, D2 = Dg[e, z, p, b, 0], Dg[e, z, p, b, 1], Dg[e, z, p, b, 2]
+                    else:
+                        D0 = 0.0
+                        D1 = 0.0
+                        D2 = 0.0
+                        for a in range(na):
+                            v = dphi[p, b, a]
+                            D0 += v * Ut[0, a]
+                            D1 += v * Ut[1, a]
+                            D2 += v * Ut[2, a]
                     D[p, b, 0], D[p, b, 1], D[p, b, 2] = D0, D1, D2
                     for k in range(3):
                         gg[p, b, k] = G[e, z, p, k, b] + (D[p, b, k] if nonlinear else 0.0)
@@ -165,12 +170,13 @@ def mitc_terms(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, Lh, U, 
                 for t in range(nt[c]):
                     k0 = off[c] + t
                     p = pts[c, t]
-                    s = 0.0
-                    for k in range(3):
-                        s += 0.5 * (G[e, z, p, k, i] * D[p, j, k] + D[p, i, k] * G[e, z, p, k, j])
-                        if nonlinear:
-                            s += 0.5 * D[p, i, k] * D[p, j, k]
-                    Ek[k0] = s if i == j else 2.0 * s
+                    if mode != 2:  # the tie strain (mode 2: σ given)
+                        s = 0.0
+                        for k in range(3):
+                            s += 0.5 * (G[e, z, p, k, i] * D[p, j, k] + D[p, i, k] * G[e, z, p, k, j])
+                            if nonlinear:
+                                s += 0.5 * D[p, i, k] * D[p, j, k]
+                        Ek[k0] = s if i == j else 2.0 * s
                     if not want_b:
                         continue
                     gi0, gi1, gi2 = gg[p, i, 0], gg[p, i, 1], gg[p, i, 2]

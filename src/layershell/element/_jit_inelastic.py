@@ -137,20 +137,56 @@ def _gradient_form(Phi, Psi, gq, A, We, q):  # pragma: no cover
 
 
 @njit(cache=True, nogil=True, fastmath=True)
-def mitc_gauss_strain(Ek, w, v, off, n, T, E):  # pragma: no cover
-    """Cartesian tied strain E (e, z, 9, 6) = T Ẽ at the Gauss points from the tie-space strains
-    Ek (e, z, nT): Ẽ_c(q) = Σ_t (w[c, q, t] + v[k]) E_k, k = off[c] + t (v (e, z, nT) the
-    consistency correction, zeros without it)."""
-    ne, nz = Ek.shape[0], Ek.shape[1]
-    Et = np.empty(6)
+def mitc_strain(nat, thL, G, M, pts, off, nt, nonlinear, w, v, T, Dg, E):  # pragma: no cover
+    """The strain pass of the MITC9 layer from the natural derivatives of the nodal vectors at the
+    sampling points, ``nat`` (P, 3, e, d + 1, 3) = Σ_n (∂_ξ N_n, ∂_η N_n, N_n) U_(n, l) (one
+    product over the elements, :func:`.inelastic_kernel._natural`): per level and point the
+    derivatives along the frame directions ∂u/∂F_b = Σ_l pw_l (M_0b nat_0l + M_1b nat_1l)
+    + dpw_l M_2b nat_2l (pw_l = (Θ³)^l, dpw_l its derivative) into ``Dg`` (e, z, P, 3, 3) [b, k]
+    (the rows pass takes them from there), the tie-space strains E_k from them (as
+    ``_jit.mitc_terms``) and the Cartesian tied strain E (e, z, 9, 6) = T Ẽ at the Gauss points,
+    Ẽ_c(q) = Σ_t (w[c, q, t] + v[e, z, k]) E_k, k = off[c] + t (v the consistency correction,
+    zeros without it)."""
+    ne, nz, P = thL.shape[0], thL.shape[1], thL.shape[2]
+    nd, nT = nat.shape[3], off[6]
+    A = np.empty((3, 3))
+    Ek, Et, pw, dpw = np.empty(nT), np.empty(6), np.empty(nd), np.empty(nd)
+    pi, pj = (0, 1, 2, 1, 0, 0), (0, 1, 2, 2, 2, 1)
     for e in range(ne):
         for z in range(nz):
+            for p in range(P):
+                th = thL[e, z, p]
+                pw[0], dpw[0] = 1.0, 0.0
+                for l in range(1, nd):
+                    pw[l] = pw[l - 1] * th
+                    dpw[l] = l * pw[l - 1]
+                for k in range(3):
+                    A[0, k] = A[1, k] = A[2, k] = 0.0
+                    for l in range(nd):
+                        A[0, k] += pw[l] * nat[p, 0, e, l, k]
+                        A[1, k] += pw[l] * nat[p, 1, e, l, k]
+                        A[2, k] += dpw[l] * nat[p, 2, e, l, k]
+                for b in range(3):
+                    m0, m1, m2 = M[e, z, p, 0, b], M[e, z, p, 1, b], M[e, z, p, 2, b]
+                    for k in range(3):
+                        Dg[e, z, p, b, k] = m0 * A[0, k] + m1 * A[1, k] + m2 * A[2, k]
+            Dz = Dg[e, z]
+            for c in range(6):
+                i, j = pi[c], pj[c]
+                for t in range(nt[c]):
+                    p = pts[c, t]
+                    s = 0.0
+                    for k in range(3):
+                        s += 0.5 * (G[e, z, p, k, i] * Dz[p, j, k] + Dz[p, i, k] * G[e, z, p, k, j])
+                        if nonlinear:
+                            s += 0.5 * Dz[p, i, k] * Dz[p, j, k]
+                    Ek[off[c] + t] = s if i == j else 2.0 * s
             for q in range(9):
                 for c in range(6):
                     s = 0.0
-                    for t in range(n[c]):
+                    for t in range(nt[c]):
                         k = off[c] + t
-                        s += (w[c, q, t] + v[e, z, k]) * Ek[e, z, k]
+                        s += (w[c, q, t] + v[e, z, k]) * Ek[k]
                     Et[c] = s
                 for V in range(6):
                     s = 0.0
@@ -272,11 +308,11 @@ def _sheet_rows(ga, Fa, sw, cw, tangent, geo, f, Bs, Gs, GSs, GTs):  # pragma: n
 
 @njit(cache=True, nogil=True, fastmath=True)
 def mitc_bulk(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, U, d, nonlinear, tangent, S, D, dV, T,
-              qn, qc, qk, qw, comp, v, ga, Fa, sw, cw, f, K):  # pragma: no cover
+              qn, qc, qk, qw, comp, v, ga, Fa, sw, cw, Dg, f, K):  # pragma: no cover
     """MITC9 forces f (e, m) and, with ``tangent``, K (e, m, m) from the law's S (e, z, 9, 6) and
     D (e, z, 9, 6, 6) at the Gauss points, element by element (the rows of one element stay in
     cache): the tie stresses and tied stiffness Ĉ_z of each level (:func:`_tie_level`), the rows
-    B_z and f (``_jit.mitc_terms``, tie stresses given), then K = Bᵀ G with G_z = Ĉ_z B_z (BLAS)
+    B_z and f (``_jit.mitc_terms``, tie stresses and the strain pass's ∂u/∂F_b ``Dg`` given), then K = Bᵀ G with G_z = Ĉ_z B_z (BLAS)
     stacked over the levels (in pieces of :data:`PRODUCT_ENTRIES`), plus the geometric term.
     Sheets (ga (e, s, n), Fa (e, s, 3), sw, cw (e, s): :func:`sheet_add`; s = 0 without) enter as
     s more rows b_s of B, c_s b_s of G and columns of the geometric operands: the same products."""
@@ -301,7 +337,7 @@ def mitc_bulk(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, U, d, no
                        Ch[z], w)
         mitc_terms(Nn, dNn, thL[e:e + 1], G[e:e + 1], M[e:e + 1], pts, off, nt, dirs, ndir, gn, gk, gJ, L0,
                    U[e:e + 1], d, nonlinear, tangent, geo, False, f[e:e + 1], B, GS[:ncol].reshape(1, ncol, na),
-                   GT[:ncol].reshape(1, ncol, na), 2, sig, E0)
+                   GT[:ncol].reshape(1, ncol, na), 2, sig, E0, Dg[e:e + 1])
         _sheet_rows(ga[e], Fa[e], sw[e], cw[e], tangent, geo, f[e], Bx[rows:], Gx[rows:], GS[ncol:], GT[ncol:])
         if not tangent:
             continue

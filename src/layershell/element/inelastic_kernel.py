@@ -12,7 +12,9 @@ last step. Reinforcement sheets (:func:`.inelastic.sheet_terms`) are added in th
   A = Φᵀ (D dV) Ψ of each point (B = g Φ, F in Φ): per (i, k) one product of the gradients
   (a × 3q) with W_ik = A_ik g (3q × a), half the multiplications of Bᵀ (D B) over 6q Voigt rows
   (about those of the elastic kernel's symmetric product); sheets by ``_jit_inelastic.sheet_add``.
-* MITC9 (:class:`.mitc.MitcBlock`): the tie-space strains E_k of each level, the Cartesian tied
+* MITC9 (:class:`.mitc.MitcBlock`): the displacement derivatives along the frame directions at
+  the sampling points (from the natural derivatives of the nodal vectors, once per element for
+  all levels; kept for the rows), the tie-space strains E_k of each level, the Cartesian tied
   strain T Ẽ at the Gauss points (Ẽ_c(q) = Σ_t (h_t(q) + v_t) E_(c,t), the tying functions and
   the consistency correction), then element by element in one compiled pass
   (``_jit_inelastic.mitc_bulk``): in the tie space σ_k = Σ_q (h_k(q) + v_k) (Tᵀ S dV)_c and
@@ -50,8 +52,9 @@ def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slic
         raise ValueError("bulk_response: the element range must be contiguous")
     U = np.ascontiguousarray(U, dtype=np.float64)
     nonlinear, tangent = bool(nonlinear), bool(tangent)
-    if not isinstance(block, LayerBlock):
-        return _mitc(block, U, nonlinear, tangent, lo, hi, stress, sheets)
+    if not isinstance(block, LayerBlock):  # BLAS single-threaded: the strain pass's product is small too
+        with blas_single_thread():
+            return _mitc(block, U, nonlinear, tangent, lo, hi, stress, sheets)
     f, K = _full(block, U, nonlinear, tangent, lo, hi, stress)
     if sheets:
         from . import _jit_inelastic as jit
@@ -64,15 +67,20 @@ def bulk_response(block, U: np.ndarray, nonlinear: bool, tangent: bool, sl: slic
 def _threads(n_el: int, work, tangent: bool) -> None:
     """``work(lo, hi)`` over element ranges, split over the kernel threads (BLAS single-threaded
     for the tangent's products, as :func:`.kernel.layer_response`)."""
-    n_threads = min(kernel_threads(), max(1, n_el // _SUB))
     with blas_single_thread() if tangent else nullcontext():
-        if n_threads == 1:
-            work(0, n_el)
-            return
-        bounds = np.linspace(0, n_el, n_threads + 1).astype(int)
-        jobs = [_pool(n_threads).submit(work, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-        for j in jobs:
-            j.result()
+        _split(n_el, work)
+
+
+def _split(n_el: int, work) -> None:
+    """``work(lo, hi)`` over element ranges, split over the kernel threads."""
+    n_threads = min(kernel_threads(), max(1, n_el // _SUB))
+    if n_threads == 1:
+        work(0, n_el)
+        return
+    bounds = np.linspace(0, n_el, n_threads + 1).astype(int)
+    jobs = [_pool(n_threads).submit(work, a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+    for j in jobs:
+        j.result()
 
 
 def _law(stress, E, tangent: bool):
@@ -147,7 +155,7 @@ _NONZEROS: dict = {}  # id(tying) -> (tying, its non-zeros); the tyings are cach
 
 
 def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress, sheets):
-    from . import _jit, _jit_inelastic as jit
+    from . import _jit_inelastic as jit
 
     if block.T is None:
         raise ValueError("bulk_response: the MITC9 block has no strain map T (build it with keep_map=True)")
@@ -161,11 +169,10 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress, sh
         keep = np.abs(block.v[lo:hi]).max(axis=-1) > V_ROUNDOFF
         v[keep] = block.v[lo:hi][keep]
     T = block.T[lo:hi]
-    Ek = np.empty((e, nz, nT))
-    _jit.mitc_terms(*_mitc_args(block, lo, hi), _NONE4, U, block.d, nonlinear, False, False, False,
-                    np.empty((e, m)), _NONE4, _NONE3, _NONE3, 1, _NONE3, Ek)
+    Dg = np.empty((e, nz, len(tie.points), 3, 3))
     Ec = np.empty((e, nz, 9, 6))
-    jit.mitc_gauss_strain(Ek, tie.w, v, tie.off, tie.n, T, Ec)
+    jit.mitc_strain(_natural(block, U), block.thL[lo:hi], block.G[lo:hi], block.M[lo:hi], tie.pts, tie.off, tie.n,
+                    nonlinear, tie.w, v, T, Dg, Ec)
     S, D = _law(stress, Ec.reshape(e, nz * 9, 6), tangent)
     S = S.reshape(e, nz, 9, 6)
     D = D.reshape(e, nz, 9, 6, 6) if tangent else np.empty((e, nz, 0, 6, 6))
@@ -178,10 +185,20 @@ def _mitc(block, U, nonlinear: bool, tangent: bool, lo: int, hi: int, stress, sh
     def work(r0: int, r1: int) -> None:
         jit.mitc_bulk(*_mitc_args(block, lo + r0, lo + r1), U[r0:r1], block.d, nonlinear, tangent, S[r0:r1],
                       D[r0:r1], dV[r0:r1], T[r0:r1], *nzw, v[r0:r1], ga[r0:r1], Fa[r0:r1], sw[r0:r1], cw[r0:r1],
-                      f[r0:r1], K[r0:r1] if tangent else _NONE3)
+                      Dg[r0:r1], f[r0:r1], K[r0:r1] if tangent else _NONE3)
 
-    _threads(e, work, tangent)
+    _split(e, work)
     return f, K
+
+
+def _natural(block, U):
+    """The natural derivatives of the nodal vectors at the sampling points, (P, 3, e, d + 1, 3):
+    Σ_n (∂_ξ N_n, ∂_η N_n, N_n) U_(n, l) at each point p, as one product (3P × 9) (9 × 3(d + 1)e)."""
+    e, nd = U.shape[0], block.d + 1
+    P = block.N.shape[0]
+    Nm = np.concatenate([block.dN[:, None, :, 0], block.dN[:, None, :, 1], block.N[:, None, :]], axis=1)
+    Un = np.ascontiguousarray(U.reshape(e, 9, 3 * nd).transpose(1, 0, 2)).reshape(9, 3 * nd * e)
+    return np.dot(Nm.reshape(3 * P, 9), Un).reshape(P, 3, e, nd, 3)
 
 
 def _stacked(sheets, e: int, a: int, tangent: bool):

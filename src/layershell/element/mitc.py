@@ -490,6 +490,7 @@ _SUB = 8  # elements per sub-block (as in kernel.py)
 
 
 _NONE3 = np.empty((0, 0, 0))  # the compiled kernel's σ input and strain output, unused by the elastic layer
+_NONE5 = np.empty((0, 0, 0, 0, 0))  # its displacement derivatives input, likewise
 _GEMM_BELOW = 60  # m below which Xᵀ X is faster as a general product (d ≤ 1: OpenBLAS syrk is slow for small m)
 
 
@@ -521,7 +522,7 @@ def _mitc_range(block: MitcBlock, sl0: int, U, nonlinear, tangent, f, K, lo: int
             tied_stiffness(block.Ct[g0:g1], tie, None if block.v is None else block.v[g0:g1]))
         _jit.mitc_terms(block.N, block.dN, block.thL[g0:g1], block.G[g0:g1], block.M[g0:g1], tie.pts, tie.off,
                         tie.n, tie.dirs, tie.ndir, tie.gn, tie.gk, tie.gJ, Lh, U[s:t], d, nonlinear, tangent, geo,
-                        lower, f[s:t], B, GS, GT, 0, _NONE3, _NONE3)
+                        lower, f[s:t], B, GS, GT, 0, _NONE3, _NONE3, _NONE5)
         if not tangent:
             continue
         Br = B.reshape(nb, nz * nT, m).transpose(0, 2, 1)
