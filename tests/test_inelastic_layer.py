@@ -132,6 +132,12 @@ def test_compiled_kernel_equals_the_plain_forms(element, d, nonlinear, mesh):
     _compare_with_plain_forms(element, d, nonlinear, mesh, 3)
 
 
+def test_compiled_mitc_strain_pass_at_cubic_directors():
+    """d = 3 (director powers up to (Θ³)³ in the strain pass's derivatives along the frame
+    directions, from the natural derivatives of the nodal vectors) on the distorted mesh."""
+    _compare_with_plain_forms("mitc", 3, True, "distorted", 4)
+
+
 def test_compiled_mitc_kernel_sums_its_product_in_pieces():
     """d = 2 with 6 thickness points: the MITC9 product Bᵀ G (6 · 37 + 18 rows of 81 columns) is
     summed over pieces (_jit_inelastic.PRODUCT_ENTRIES), equal to the plain forms."""
