@@ -312,8 +312,9 @@ def mitc_bulk(Nn, dNn, thL, G, M, pts, off, nt, dirs, ndir, gn, gk, gJ, U, d, no
     """MITC9 forces f (e, m) and, with ``tangent``, K (e, m, m) from the law's S (e, z, 9, 6) and
     D (e, z, 9, 6, 6) at the Gauss points, element by element (the rows of one element stay in
     cache): the tie stresses and tied stiffness Ĉ_z of each level (:func:`_tie_level`), the rows
-    B_z and f (``_jit.mitc_terms``, tie stresses and the strain pass's ∂u/∂F_b ``Dg`` given), then K = Bᵀ G with G_z = Ĉ_z B_z (BLAS)
-    stacked over the levels (in pieces of :data:`PRODUCT_ENTRIES`), plus the geometric term.
+    B_z and f (``_jit.mitc_terms``, tie stresses and the strain pass's ∂u/∂F_b ``Dg`` given), then
+    K = Bᵀ G with G_z = Ĉ_z B_z (BLAS) stacked over the levels (in pieces of
+    :data:`PRODUCT_ENTRIES`), plus the geometric term.
     Sheets (ga (e, s, n), Fa (e, s, 3), sw, cw (e, s): :func:`sheet_add`; s = 0 without) enter as
     s more rows b_s of B, c_s b_s of G and columns of the geometric operands: the same products."""
     ne, nz = thL.shape[0], thL.shape[1]
