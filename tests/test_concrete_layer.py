@@ -159,7 +159,9 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('{material = "b500"', '{material = "rebar"'), "reinforcement[0].material", "unknown material"),
     (('bar_diameter = 10.0, spacing = 200.0', 'bar_diameter = 10.0'), "reinforcement", "spacing"),
     (('grade = "B500B"', 'grade = "S235"'), "materials.b500", "B500"),
-    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "refine the mesh"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "crack_spacing"),
+    (('directors = 2\n', 'directors = 2\ncrack_spacing = -1.0\n'), "layers[0].crack_spacing", "greater than or equal to 0"),
+    (('directors = 2\n', 'directors = 2\ncrack_spacing = 2000.0\n'), "layers[0].crack_spacing", "snap-back limit"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = -0.1'), "materials.c30.G_F", "greater than 0"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.0'), "materials.c30.G_F",
      "tensile fracture energy (force/length)"),
@@ -182,15 +184,19 @@ def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
 
 
 def test_crack_band_limit_names_the_largest_element():
-    """A G_F that puts the snap-back limit 2 G_F E / f_ct² below the band of 250 mm elements: the
-    error names the largest element size that passes (between the 250 mm that fail and the
-    167 mm of the next mesh with a node row at the load), and that mesh builds."""
+    """A G_F that puts the snap-back limit 2 G_F E / f_ct² below the band of 250 mm elements (the
+    layer on the element band, crack_spacing = 0): the error names the largest element size that
+    passes (between the 250 mm that fail and the 167 mm of the next mesh with a node row at the
+    load), and that mesh builds; on the bars' crack spacing (241 mm) the error names it."""
     gf = 'strength_class = "C30/37"\nG_F = 0.02'
+    on_element = ('directors = 2\n', 'directors = 2\ncrack_spacing = 0\n')
     with pytest.raises(InputError, match="snap-back limit") as err:
-        build(parse(strip_model(6, 4).replace('strength_class = "C30/37"', gf)))
+        build(parse(strip_model(6, 4).replace('strength_class = "C30/37"', gf).replace(*on_element)))
     size = float(re.search(r"elements up to ([0-9.]+) across", str(err.value)).group(1))
     assert 1500.0 / 9 < size < 1500.0 / 6
-    build(parse(strip_model(9, 4).replace('strength_class = "C30/37"', gf)))
+    build(parse(strip_model(9, 4).replace('strength_class = "C30/37"', gf).replace(*on_element)))
+    with pytest.raises(InputError, match=r"'layers\[0\]': the mean crack spacing .* 241"):
+        build(parse(strip_model(9, 4).replace('strength_class = "C30/37"', gf)))
 
 
 def test_crack_width_probe_needs_a_concrete_layer():
