@@ -190,14 +190,16 @@ class ConcreteLaw:
         """Raise :class:`MaterialError` if a crack band h = h_t sin θ + h_z |cos θ| ≤ √(h_t² + h_z²)
         (h_t = :meth:`tension_band` of h_in) can reach :meth:`max_band` (the exponential softening
         would need snap-back)."""
-        h_in = self.tension_band(h_in)
-        h = np.sqrt(h_in ** 2 + np.asarray(h_z, float) ** 2)
+        h_t = self.tension_band(h_in)
+        h = np.sqrt(h_t ** 2 + np.asarray(h_z, float) ** 2)
         if np.any(h >= self.max_band()):
+            spacing = (f", or give the layer a smaller crack_spacing (its in-plane band is at least "
+                       f"{self.crack_spacing:.4g})" if self.crack_spacing > 0 else "")
             raise MaterialError(
-                f"layer '{name}' (concrete '{self.name}'): the element size h_in={np.max(h_in):.4g} with "
+                f"layer '{name}' (concrete '{self.name}'): the in-plane band h_t={np.max(h_t):.4g} with "
                 f"thickness-point spacing h_z={np.max(h_z):.4g} gives crack bands up to {np.max(h):.4g}, "
                 f"beyond the snap-back limit 2 G_F E / f_ct² = {self.max_band():.4g}; refine the mesh "
-                "(smaller elements) or use more thickness points in this layer")
+                f"(smaller elements) or use more thickness points in this layer{spacing}")
 
     def state(self, n: int) -> ConcreteState:
         """Virgin committed state of ``n`` points."""
