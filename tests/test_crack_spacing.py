@@ -17,6 +17,7 @@ from layershell.io.errors import InputError
 from layershell.laws import ConcreteLaw
 from layershell.material import MaterialError
 from layershell.runner import run
+from test_strengthened_strip import TRC
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "rc_strip.toml"
 
@@ -49,13 +50,16 @@ def strip_file(tmp_path, nx: int, layer_line: str = "", rebar: tuple[str, str] |
 
 def test_layer_with_bars_takes_their_mean_crack_spacing(tmp_path):
     """The strip's layer takes s_rm = 240.99 mm (worked above); given, crack_spacing replaces it;
-    0 keeps the element band; the concrete layers without bars of the IC debonding example keep it."""
+    0 keeps the element band; concrete layers without steel bars (the IC debonding example's, the
+    TRC strip's mortar with its textile) keep it."""
     law = load(strip_file(tmp_path, 6)).model.layers[0].law
     assert law.crack_spacing == pytest.approx(240.99, abs=0.01)
     assert load(strip_file(tmp_path, 6, "crack_spacing = 150.0")).model.layers[0].law.crack_spacing == 150.0
     assert load(strip_file(tmp_path, 6, "crack_spacing = 0")).model.layers[0].law.crack_spacing == 0.0
     ic = load(EXAMPLE.with_name("rc_strip_ic_debonding.toml")).model
     assert [ly.law.crack_spacing for ly in ic.layers if hasattr(ly.law, "f_ct")] == [0.0, 0.0]
+    trc = build(parse(TRC.replace("crack_spacing = 0 ", "# "))).model  # the TRC strip, its slab on the bars
+    assert [ly.law.crack_spacing for ly in trc.layers] == [pytest.approx(240.99, abs=0.01), 0.0]  # mortar: textile
 
 
 def test_crack_band_is_the_spacing_where_elements_are_shorter():
