@@ -24,9 +24,9 @@ ASDConcrete3D), without plastic strain, explicit in the strain (no local iterati
 Crack band: fixed when a point first cracks, h = h_t sin θ + h_z |cos θ| with θ between the crack
 normal (principal direction of σ̄_max at onset) and the shell normal, h_t = max(h_in,
 ``crack_spacing``): in a layer with bonded bars the cracks distribute at the bars' crack spacing
-s, so an element shorter than s smears one crack's opening over s, not over itself (Bažant & Oh
-1983, reinforced concrete; Rots 1988; the crack bandwidth of reinforced elements in DIANA);
-``crack_spacing`` = 0 (plain concrete) keeps the element band. Crushing uses h_in: it localises
+s, so an element shorter than s smears one crack's opening over s, not over itself (the crack
+band model for reinforced concrete: Bažant & Oh 1983; Rots 1988); ``crack_spacing`` = 0 (plain
+concrete) keeps the element band. Crushing uses h_in: it localises
 across an in-plane element length (compression normal to the mid-surface is not a shell's
 failure mode).
 
