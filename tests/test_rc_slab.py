@@ -158,17 +158,17 @@ def within_ten_percent_up_to(w: np.ndarray, P: np.ndarray) -> tuple[float, np.nd
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")  # the crack probes jump as cracks open
-@pytest.mark.parametrize("mesh, w_ok, worst, p_fail", [("4x4", 2.75, 0.086, None), ("6x6", 5.0, 0.086, None),
-                                                       ("12x12", 1.25, 0.078, 10.94)])
+@pytest.mark.parametrize("mesh, w_ok, worst, p_fail", [("4x4", 2.75, 0.085, None), ("6x6", 5.0, 0.076, None),
+                                                       ("12x12", 3.25, 0.068, 8.96)])
 def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
     """The measured load is matched within 10 % up to the deflection w_ok (mm; 5.0: the whole
     measured curve, to 10.8 kN), the largest difference there being `worst`; the test's initial
-    stiffness within 3 % on every mesh. 76 mm elements are near the crack spacing. Longer
-    ones (152 mm away from the corner, crack band 110 mm) lose the tension between the cracks
-    too early: too soft from w = 3 mm on. Shorter ones (38 mm) keep too much of it: too stiff
-    by up to 13 % from w = 1.5 mm on (docs/concrete.md, limits); there the load point punches
-    through at p_fail (kN): the load falls by more than half within one step and the measuring
-    point springs back."""
+    stiffness within 3 % on every mesh. The slab's cracks take the bars' crack spacing (60 mm,
+    the example's crack_spacing) as their band where elements are shorter. Elements of 152 mm
+    away from the corner (crack band 110 mm) lose the tension between the cracks too early: too
+    soft from w = 3 mm on. On 38 mm elements the load point punches through at p_fail (kN): the
+    load falls by more than half within one step and the measuring point springs back
+    (docs/concrete.md, limits)."""
     w, P, _ = load_deflection(MESHES[mesh])
     reached, err = within_ten_percent_up_to(w, P)
     assert reached == w_ok, err.round(3)
@@ -184,7 +184,7 @@ def test_load_deflection_against_the_measured_curve(mesh, w_ok, worst, p_fail):
 
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore::layershell.runner.JumpWarning")
-@pytest.mark.parametrize("n, p_fail", [(6, 9.43), (9, 7.97)])
+@pytest.mark.parametrize("n, p_fail", [(6, 9.25), (9, 6.99)])
 def test_a_bare_point_support_fails_earlier_on_finer_meshes(n, p_fail):
     """Without the bearing plate (the soffit held at one node) the slab fails at its support: within
     one step the load falls below 0.6 of its peak p_fail (kN), when the crack in the corner element

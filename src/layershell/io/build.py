@@ -985,37 +985,89 @@ def crack_band_notes(model: Model) -> list[str]:
 
 
 #: elements whose crack band is shorter than this fraction of the bars' mean crack spacing keep
-#: too much tension between cracks: the RC strip's moment at first yield rose 6 % at 0.47 s_rm
+#: too much tension between cracks (where the layer takes the element band): the RC strip's moment
+#: at first yield rose 6 % at 0.47 s_rm
 BAND_PER_SPACING = 0.5
 
 
-def crack_spacing_notes(model: Model) -> list[str]:
-    """A note per concrete layer with steel bars (given as bar_diameter and spacing) whose elements'
-    crack band is shorter than :data:`BAND_PER_SPACING` of the bars' mean crack spacing (EN 1992-1-1
-    §7.3.4, :func:`layershell.analytic.crack_spacing.mean_crack_spacing`): with perfectly bonded bars
-    every such element cracks and keeps the tension of its own short band."""
-    from ..analytic.crack_spacing import mean_crack_spacing
-    from ..element.inelastic import in_plane_band
+def _steel_bars(reinforcement) -> tuple[list, list]:
+    """The steel sheets of a layer given as bars (bar_diameter) and those given by area only."""
     from ..laws.uniaxial import SteelLaw
+
+    steel = [r for r in reinforcement if isinstance(r.law, SteelLaw)]
+    return [r for r in steel if r.bar_diameter], [r for r in steel if not r.bar_diameter]
+
+
+def bars_crack_spacing(reinforcement, thickness: float) -> float | None:
+    """The least mean crack spacing s_rm (EN 1992-1-1 §7.3.4,
+    :func:`layershell.analytic.crack_spacing.mean_crack_spacing`) of the steel bars among
+    ``reinforcement`` (cover to the nearer face of a layer ``thickness`` deep); None without bars
+    given by bar_diameter."""
+    from ..analytic.crack_spacing import mean_crack_spacing
+
+    bars, _ = _steel_bars(reinforcement)
+    if not bars:
+        return None
+    t = float(thickness)
+    return min(mean_crack_spacing(max(min(r.height, t - r.height) - 0.5 * r.bar_diameter, 1e-3 * t),
+                                  r.bar_diameter, r.area, t) for r in bars)
+
+
+def _layer_crack_spacing(ld: schema.LayerDef, i: int, law, reinforcement, th: np.ndarray):
+    """The concrete ``law`` of layer ``i`` with its crack spacing: ``crack_spacing`` as given, else
+    :func:`bars_crack_spacing` of its bars (0 without)."""
+    if not hasattr(law, "crack_spacing"):
+        if ld.crack_spacing is not None:
+            raise InputError(f"'layers[{i}].crack_spacing': sets the crack band of a concrete layer, but layer "
+                             f"'{ld.name}' has no concrete material; remove 'crack_spacing' from it")
+        return law
+    if ld.crack_spacing is not None:
+        try:
+            out = replace(law, crack_spacing=float(ld.crack_spacing))
+            out.check()
+        except MaterialError as exc:
+            raise InputError(f"'layers[{i}].crack_spacing': {exc}") from None
+        return out
+    s = bars_crack_spacing(reinforcement, float(np.median(th))) or 0.0
+    if not s < law.max_band():
+        raise InputError(f"'layers[{i}]': the mean crack spacing of the bars of layer '{ld.name}', {s:.4g} (EN 1992-1-1 "
+                         f"§7.3.4), over which its cracks' opening is smeared, reaches the snap-back limit "
+                         f"2 G_F E / f_ct² = {law.max_band():.4g} of concrete '{law.name}'; check G_F and its units "
+                         "(force/length: N/mm for 'N, mm'), or give the layer a smaller crack_spacing (0: the element "
+                         "band, which the mesh must then keep below the limit)")
+    return replace(law, crack_spacing=s)
+
+
+def crack_spacing_notes(model: Model) -> list[str]:
+    """A note per concrete layer with steel bars whose crack band is the element's: where the bars
+    are given by area only (no crack spacing known), and where ``crack_spacing = 0`` leaves elements
+    with a band shorter than :data:`BAND_PER_SPACING` of the bars' mean crack spacing (EN 1992-1-1
+    §7.3.4): with perfectly bonded bars every such element cracks and keeps the tension of its
+    own short band."""
+    from ..element.inelastic import in_plane_band
 
     notes = []
     for k, ly in enumerate(model.layers):
-        bars = [r for r in ly.reinforcement if isinstance(r.law, SteelLaw) and r.bar_diameter]
-        if ly.law is None or not hasattr(ly.law, "f_ct") or not bars:
+        bars, by_area = _steel_bars(ly.reinforcement)
+        if getattr(ly.law, "crack_spacing", None) != 0.0 or not (bars or by_area):
             continue
-        el = model.layer_elements(k)
-        conn = model.mesh.elements[el]
+        if by_area and not bars:
+            notes.append(f"layer '{ly.name}': its steel bars are given by area, so their crack spacing is unknown and "
+                         "a crack's band is the element's (13/18 √area); with perfectly bonded bars elements shorter "
+                         "than the crack spacing each crack and keep the tension of their own short band, so the member "
+                         "comes out too strong (docs/concrete.md, limits): give the bars by bar_diameter and spacing, "
+                         "or the layer's crack_spacing")
+            continue
+        conn = model.mesh.elements[model.layer_elements(k)]
         band = in_plane_band(model.mesh.nodes[conn])
-        t = float(np.median(ly.thickness[conn]))
-        s_rm = min(mean_crack_spacing(max(min(r.height, t - r.height) - 0.5 * r.bar_diameter, 1e-3 * t),
-                                      r.bar_diameter, r.area, t) for r in bars)
+        s_rm = bars_crack_spacing(bars, float(np.median(ly.thickness[conn])))
         short = band < BAND_PER_SPACING * s_rm
         if short.any():
-            notes.append(f"layer '{ly.name}': {int(short.sum())} element(s) have a crack band down to {band.min():.3g} "
-                         f"(13/18 √area), less than half the mean crack spacing of its bars, {s_rm:.3g} (EN 1992-1-1 "
-                         "§7.3.4); with perfectly bonded bars every such element cracks and keeps the tension of its "
-                         "own short band, so the member comes out too strong and may stop (docs/concrete.md, limits): "
-                         f"use elements of about {s_rm:.3g} along the span where the concrete cracks")
+            notes.append(f"layer '{ly.name}': crack_spacing = 0 leaves {int(short.sum())} element(s) a crack band down "
+                         f"to {band.min():.3g} (13/18 √area), less than half the mean crack spacing of its bars, "
+                         f"{s_rm:.3g} (EN 1992-1-1 §7.3.4); with perfectly bonded bars every such element cracks and "
+                         "keeps the tension of its own short band, so the member comes out too strong and may stop "
+                         "(docs/concrete.md, limits): leave crack_spacing out (the bars' spacing) or give it")
     return notes
 
 
@@ -1068,8 +1120,11 @@ def _layer(ld: schema.LayerDef, mats: dict, th: np.ndarray, mesh_type: str, laws
     if direction is None and mesh_type == "plate_with_circle":
         direction = (1.0, 0.0, 0.0)  # its elements' first coordinate lines turn around the front
     if ld.plies is None:
+        reinforcement = _reinforcement(ld, i, laws)
+        law = laws.get(ld.material)
         return Layer(ld.name, mats[ld.material], ld.directors, th, ld.angle, direction,
-                     law=laws.get(ld.material), reinforcement=_reinforcement(ld, i, laws))
+                     law=_layer_crack_spacing(ld, i, law, reinforcement, th), reinforcement=reinforcement)
+    _layer_crack_spacing(ld, i, None, (), th)  # a ply stack has no concrete law
     total = sum(p.thickness for p in ld.plies)
     plies = tuple(Ply(mats[p.material], p.angle, p.thickness / total) for p in ld.plies)
     equivalent = laminate_equivalent([(p.material, p.angle, p.fraction) for p in plies],

@@ -435,6 +435,11 @@ class LayerDef(Strict):
     reinforcement: list[ReinforcementDef] = Field(default_factory=list, description=(
         "steel bars or textile inside the layer: [{material = 'b500', height = 0.03, bar_diameter = 0.01, spacing "
         "= 0.2, direction = [1, 0, 0]}, ...], bonded to the layer (no extra unknowns)"))
+    crack_spacing: FiniteFloat | None = Field(None, ge=0.0, description=(
+        "concrete layer: the spacing of the cracks its bars distribute (length), the least in-plane band over "
+        "which a crack's opening is smeared (elements shorter than it take it as their band; crushing keeps the "
+        "element). Left out: the mean crack spacing s_r,max/1.7 of EN 1992-1-1 §7.3.4 of its steel bars given "
+        "by bar_diameter and spacing (none without them); 0: the element band"))
 
     @field_validator("thickness")
     @classmethod

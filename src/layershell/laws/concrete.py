@@ -21,10 +21,14 @@ ASDConcrete3D), without plastic strain, explicit in the strain (no local iterati
   k = E ε_c1/f_c, read as a secant damage, then σ = f_c exp(-(ε - ε_c1) h f_c/G_c) beyond the peak
   (area under the post-peak branch × h = G_c).
 
-Crack band: fixed when a point first cracks, h = h_in sin θ + h_z |cos θ| with θ between the crack
-normal (principal direction of σ̄_max at onset) and the shell normal. Crushing uses h_in: it
-localises across an in-plane element length (compression normal to the mid-surface is not a
-shell's failure mode).
+Crack band: fixed when a point first cracks, h = h_t sin θ + h_z |cos θ| with θ between the crack
+normal (principal direction of σ̄_max at onset) and the shell normal, h_t = max(h_in,
+``crack_spacing``): in a layer with bonded bars the cracks distribute at the bars' crack spacing
+s, so an element shorter than s smears one crack's opening over s, not over itself (the crack
+band model for reinforced concrete: Bažant & Oh 1983; Rots 1988); ``crack_spacing`` = 0 (plain
+concrete) keeps the element band. Crushing uses h_in: it localises
+across an in-plane element length (compression normal to the mid-surface is not a shell's
+failure mode).
 
 Optional shear retention (``shear_retention`` = β, default 0): an open crack keeps β μ across the
 plane of its fixed normal n, σ += β d⁺ Q_n(σ̄⁺) (:func:`crack_shear_projector`). Increment stiffness
@@ -114,6 +118,9 @@ class ConcreteLaw:
     #: interlock, as the constant shear retention of fixed smeared cracks); 0: none beyond the
     #: split's own, since 0.2 locks the stress of a separating plain beam (docs/concrete.md, limits)
     shear_retention: float = 0.0
+    #: s, the in-plane tension band's lower bound (model length): the mean crack spacing of bars
+    #: bonded in the layer (the crack band theory's band of distributed cracking); 0: the element band
+    crack_spacing: float = 0.0
     name: str = "concrete"
 
     # -- construction --------------------------------------------------------------------------
@@ -160,6 +167,13 @@ class ConcreteLaw:
         if not 0.0 <= self.shear_retention <= 1.0:
             raise MaterialError(f"concrete '{self.name}': shear_retention={self.shear_retention} must lie in "
                                 "[0, 1] (the fraction of the shear modulus an open crack keeps); 0 keeps none")
+        if not (np.isfinite(self.crack_spacing) and self.crack_spacing >= 0.0):
+            raise MaterialError(f"concrete '{self.name}': crack_spacing={self.crack_spacing} must be a length >= 0 "
+                                "(the mean spacing of the cracks the bars distribute); 0 keeps the element band")
+        if not self.crack_spacing < self.max_band():
+            raise MaterialError(f"concrete '{self.name}': crack_spacing={self.crack_spacing:.4g} reaches the "
+                                f"snap-back limit 2 G_F E / f_ct² = {self.max_band():.4g} of the softening over "
+                                "that band; give a smaller crack_spacing, or 0 for the element band")
         if not self.k_b >= 1.0:
             raise MaterialError(f"concrete '{self.name}': k_b={self.k_b} (biaxial/uniaxial compressive "
                                 "strength) must be at least 1; Kupfer's value is 1.16")
@@ -168,16 +182,24 @@ class ConcreteLaw:
         """Largest crack band without snap-back in tension: 2 G_F E / f_ct²."""
         return 2.0 * self.G_F * self.E / self.f_ct ** 2
 
+    def tension_band(self, h_in):
+        """The in-plane band of a crack across the layer: max(h_in, ``crack_spacing``)."""
+        return np.maximum(np.asarray(h_in, float), self.crack_spacing)
+
     def check_band(self, h_in, h_z, name: str) -> None:
-        """Raise :class:`MaterialError` if a crack band h = h_in sin θ + h_z |cos θ| ≤ √(h_in² + h_z²)
-        can reach :meth:`max_band` (the exponential softening would need snap-back)."""
-        h = np.sqrt(np.asarray(h_in, float) ** 2 + np.asarray(h_z, float) ** 2)
+        """Raise :class:`MaterialError` if a crack band h = h_t sin θ + h_z |cos θ| ≤ √(h_t² + h_z²)
+        (h_t = :meth:`tension_band` of h_in) can reach :meth:`max_band` (the exponential softening
+        would need snap-back)."""
+        h_t = self.tension_band(h_in)
+        h = np.sqrt(h_t ** 2 + np.asarray(h_z, float) ** 2)
         if np.any(h >= self.max_band()):
+            spacing = (f", or give the layer a smaller crack_spacing (its in-plane band is at least "
+                       f"{self.crack_spacing:.4g})" if self.crack_spacing > 0 else "")
             raise MaterialError(
-                f"layer '{name}' (concrete '{self.name}'): the element size h_in={np.max(h_in):.4g} with "
+                f"layer '{name}' (concrete '{self.name}'): the in-plane band h_t={np.max(h_t):.4g} with "
                 f"thickness-point spacing h_z={np.max(h_z):.4g} gives crack bands up to {np.max(h):.4g}, "
                 f"beyond the snap-back limit 2 G_F E / f_ct² = {self.max_band():.4g}; refine the mesh "
-                "(smaller elements) or use more thickness points in this layer")
+                f"(smaller elements) or use more thickness points in this layer{spacing}")
 
     def state(self, n: int) -> ConcreteState:
         """Virgin committed state of ``n`` points."""
@@ -350,13 +372,13 @@ class ConcreteLaw:
         r_c, d_c, ddc, r_t, load_t, dtau_t = self._histories(w, committed, h_in)
         onset = (committed.h_t <= 0) & (r_t > self.f_ct)
         on = np.flatnonzero(onset)
-        h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], h_in[on], h_z[on])
+        h_new, v_new, dh_row = self._band(V[on], w[on], normal[on], self.tension_band(h_in[on]), h_z[on])
         h_t = committed.h_t.copy()
         h_t[on] = h_new
         if np.any(h_t >= self.max_band()):
             i = int(np.argmax(h_t >= self.max_band()))
             raise MaterialError(
-                f"concrete '{self.name}': a crack band h={h_t[i]:.4g} (element size h_in={h_in[i]:.4g}, "
+                f"concrete '{self.name}': a crack band h={h_t[i]:.4g} (in-plane band {self.tension_band(h_in[i]):.4g}, "
                 f"thickness-point spacing h_z={h_z[i]:.4g}) exceeds the snap-back limit 2 G_F E / f_ct² = "
                 f"{self.max_band():.4g}; refine the mesh or use more thickness points (check_band finds "
                 "this before the analysis)")
