@@ -275,7 +275,7 @@ def test_band_width_from_the_crack_orientation_and_snap_back_limit():
     assert abs(st_.n1[0]) == pytest.approx(np.sqrt(0.5)) and abs(st_.n3[0]) == pytest.approx(np.sqrt(0.5))
     assert law.max_band() == pytest.approx(2 * law.G_F * law.E / law.f_ct ** 2)
     law.check_band(np.array([300.0]), np.array([20.0]), "slab")
-    with pytest.raises(MaterialError, match=r"layer 'slab'.*h_in=2000.*refine the mesh.*thickness points"):
+    with pytest.raises(MaterialError, match=r"layer 'slab'.*h_t=2000.*refine the mesh.*thickness points"):
         law.check_band(np.array([2000.0]), np.array([20.0]), "slab")
     eps = np.zeros((1, 6))
     eps[0, 0] = 2 * law.f_ct / law.E
