@@ -10,7 +10,7 @@ thesis's law) on the meshes given and prints first damage / first full debonding
 ``--beyond``: load past the design load to λ = 1.2 (steps of 0.1 to 0.9, then 0.01), where the
 interface debonds completely at a first point (first_delamination_load_factor).
 ``--arc``: traced by arc length (``[steps] control = "arc_length"``) instead of load steps.
-``--element mitc``: the MITC9 element instead of the example's; ``--reuse never|always``: the
+``--element mitc|full``: that element instead of the example's (the cohesive plate: MITC9); ``--reuse never|always``: the
 linear solver's ``[steps] reuse_factorization`` (default auto: GMRES on kept factorisations;
 the printed ``linear_solves`` count them). ``--only-thesis CASES``: the thesis-law plates
 cantilever_plate_<case>.toml alone (strong, weak, slip); ``--rule lobatto|gauss``: their
@@ -19,6 +19,7 @@ points, the default; docs/user-guide.md "Refined meshes with the thesis's law").
 """
 from __future__ import annotations
 
+import re
 import sys
 import time
 from pathlib import Path
@@ -35,8 +36,11 @@ def study(name: str, n: int, beyond: bool = False, element: str | None = None, r
     text = path.read_text()
     if rule is not None:
         text = text.replace("[[interfaces]]", f'[[interfaces]]\nrule = "{rule}"', 1)
-    if element is not None:
-        text = text.replace('element = "full"', f'element = "{element}"')
+    if element is not None:  # the example's [model] element, or one added after its nonlinear switch
+        if 'element = "' in text:
+            text = re.sub(r'element = "\w+"', f'element = "{element}"', text)
+        else:
+            text = text.replace("nonlinear = true", f'nonlinear = true\nelement = "{element}"', 1)
     for key in ("nx", "ny"):
         for old in (3, 6):
             text = text.replace(f"{key} = {old}\n", f"{key} = {n}\n")

@@ -41,7 +41,11 @@ def test_load_on_the_dome_only_and_axisymmetric(linear_runs):
         # axisymmetric response: the whole top edge moves down alike
         spec_probe = next(p for p in _spec(name).probes if p.name == "w_top")
         w = spec_probe.samples(pb.model, pb.dm, res.u)
-        assert w.size == 40 and np.ptp(w) < 1e-4 * w.max() and w.min() > 0  # corner vs mid-side nodes: 2e-6
+        # (the edge's nodes alternate corner / mid-side; MITC9 moves the two apart by 4e-4 of w, the
+        # curved edge's discretisation, while each set stays uniform around the ring to 1e-12)
+        assert w.size == 40 and w.min() > 0, name
+        assert np.ptp(w[0::2]) < 1e-8 * w.max() and np.ptp(w[1::2]) < 1e-8 * w.max(), name
+        assert np.ptp(w) < 1e-3 * w.max(), name
 
 
 def _spec(name: str):
@@ -89,7 +93,7 @@ def test_support_variants_vs_thesis(linear_runs):
 
 
 @pytest.mark.xfail(strict=True, reason="known gap: with the assumed 0.86 m lower ring beam and the haunch over the "
-                   "lowest dome row (thesis figures missing) w_top is about 28 % below the thesis; see "
+                   "lowest dome row (thesis figures missing) w_top is about 30 % below the thesis; see "
                    "examples/kruemmel_dome_linear.toml")
 def test_top_displacement_magnitude_vs_thesis(linear_runs):
     for name, res in linear_runs.items():
@@ -121,8 +125,8 @@ def linear_onset(name: str) -> float:
 
 NONLINEAR = {
     # name: (thesis onset, load steps used here: coarse before the onset, 40 kN/m² after)
-    "kruemmel_dome_half_load": (557.0, [400.0, 720.0, 780.0, 820.0, 860.0, 900.0]),
-    "kruemmel_dome_pressure_suction": (624.0, [400.0, 670.0, 710.0, 750.0, 790.0, 830.0]),
+    "kruemmel_dome_half_load": (557.0, [400.0, 500.0, 520.0, 540.0, 560.0, 580.0]),
+    "kruemmel_dome_pressure_suction": (624.0, [400.0, 770.0, 800.0, 830.0, 860.0, 890.0]),
 }
 
 
@@ -145,16 +149,18 @@ def test_delamination_onset_matches_the_linear_prediction(name):
     assert onset is not None, f"no delamination up to {lam[-1]} (linear prediction {lam_lin:.0f})"
     k = lam.index(onset)
     # the onset is the first step at or above the prediction, ±5 % for the geometric nonlinearity
-    # (measured with finer steps: nonlinear onset 835-850 vs 862 half-sided, 730-740 vs 752 pressure/suction)
+    # (measured with these steps: nonlinear onset 520-540 vs 538 half-sided, 800-830 vs 859 pressure/suction)
     assert lam[k] >= 0.95 * lam_lin and (k == 0 or lam[k - 1] < 1.05 * lam_lin), (lam_lin, lam)
     assert all(a == 0 for a in area[:k]) and area[k] > 0
     assert all(b >= a for a, b in zip(area, area[1:]))  # debonding is irreversible
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="known gap: this model's onset (linear prediction about 860 kN/m² half-sided, "
-                   "750 kN/m² pressure/suction) lies 20-55 % above the thesis's 557 / 624 kN/m²; see "
-                   "examples/kruemmel_dome_half_load.toml")
-@pytest.mark.parametrize("name", list(NONLINEAR))
+@pytest.mark.parametrize("name", [
+    "kruemmel_dome_half_load",  # linear prediction 538 kN/m², thesis 557
+    pytest.param("kruemmel_dome_pressure_suction", marks=pytest.mark.xfail(
+        strict=True, reason="known gap: this model's onset (linear prediction 859 kN/m²) lies 38 % above the "
+        "thesis's 624 kN/m²; see examples/kruemmel_dome_pressure_suction.toml")),
+])
 def test_delamination_onset_vs_thesis(name):
     assert linear_onset(name) == pytest.approx(NONLINEAR[name][0], rel=0.15)

@@ -171,3 +171,24 @@ def test_mmb_on_three_meshes(mmb_100):
         balances.append(max(abs(st["energy"]["balance_error"]) for st in s["steps"]))
     assert max(medians) - min(medians) < 0.005, medians
     assert max(balances) < 0.01, balances
+
+
+def _branch_ratio(lam, a):
+    """Load factor over beam theory's at the compliance crack length, past the peak, a < 48.5 mm."""
+    peak = int(np.argmax(np.where(np.isfinite(a), lam, -np.inf)))
+    branch = (np.arange(lam.size) > peak) & np.isfinite(a) & (a < 48.5)
+    return lam[branch] / np.array([mmb_load_factor(x) for x in a[branch]])
+
+
+@pytest.mark.slow
+def test_mmb_keeps_the_full_element_because_mitc9_lies_further_above_beam_theory(mmb_100):
+    """Why examples/mmb_cohesive.toml sets element = "full": with MITC9 (100 elements) the run
+    passes the peak and reaches its end as well, but its branch lies up to +4.1 % above beam
+    theory (full element +0.4 ... +3.3 %), past the +4 % the example is checked to, and its
+    median further above than the full element's. About 2 CPU minutes more than the fixture."""
+    s, lam, D, a, dissipated = mmb_path({'element = "full"': 'element = "mitc"'})
+    assert s["converged"] and s["path_end"] == "lambda_end"
+    ratio = _branch_ratio(lam, a)
+    assert ratio.size >= 10 and np.all((ratio > 0.98) & (ratio < 1.05)), ratio
+    full = _branch_ratio(mmb_100[1], mmb_100[3])
+    assert np.median(ratio) > np.median(full)

@@ -199,3 +199,17 @@ def test_the_comparison_detects_a_misread_mesh(kind, monkeypatch, twin_run):
     assert rg.converged
     diff = _differences(rg, twin_run)
     assert max(diff.values()) > 100 * BOUND, diff
+
+
+@pytest.mark.slow  # one run of the example with MITC9: about 15 s of CPU
+def test_the_example_keeps_the_full_element_because_mitc9_debonds_the_whole_plate():
+    """Why plate_gmsh.toml sets element = "full" (the thesis's element, like the §5.1 plates it is
+    made from): with MITC9 the stress criterion on this 3 × 3 mesh debonds the whole interface
+    (the TRC part, 6 m²) by λ = 0.875, and the layers, held by contact and friction alone, have
+    no equilibrium at the next load (the run stops; tests/test_delamination.py has the same for
+    the slip-friction plate)."""
+    r = run(_spec(False, {**TIGHT, 'element = "full"\n': ""}), None, write_vtu=False)
+    assert not r.converged
+    area = [a["concrete/trc"] for a in r.summary["debonded_area"]]
+    assert area[-1] == pytest.approx(6.0) and r.summary["steps"][-1]["load_factor"] == pytest.approx(0.875)
+    assert "every interface point had debonded" in r.summary["error"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -251,3 +252,24 @@ def test_pulloff_with_the_thesis_procedure_front_lags_as_in_the_thesis(pulloff):
     assert mid[-1] < 7 * ELEMENT_LENGTH  # λ = 0.75: not beyond the 6/7 edge's region
     area = res.summary["steps"][-1]["debonded_area"][INTERFACE]
     assert area < 0.8 * HALF_WIDTH * BOND_END  # far from the whole strap
+
+
+@pytest.mark.slow
+def test_pulloff_keeps_the_full_element_because_mitc9_moves_the_onset():
+    """Why examples/pulloff.toml sets element = "full": with MITC9 the contact between the debonded
+    layers at the face Gauss points finds no equilibrium in the first step (its set keeps
+    changing), so it moves to the nodes, and the first release (λ = 0.25, 7.5 kN: 30 % below the
+    thesis's 10.7 kN; predicted 0.241 from the tractions) lies in the middle of element 5
+    (x = 135 mm), not at the 4/5 edge the thesis names. The whole run then debonds the strap at
+    λ = 0.70 (21 kN) and has no equilibrium beyond. Run here to λ = 0.30."""
+    text = EXAMPLE.read_text().replace('element = "full"', 'element = "mitc"')
+    lams = [0.05, 0.10, 0.15, 0.20, 0.25, 0.30]
+    text = re.sub(r"factors = \[[^\]]*\]", f"factors = {lams}", text)
+    res, released = run_with_released_points(build(parse(text, str(EXAMPLE)), EXAMPLE.parent), None)
+    assert res.converged
+    assert [m["load_factor"] for m in res.summary["contact_moved_to_nodes"]] == [0.0]
+    k = [s["load_factor"] for s in res.summary["steps"]].index(res.summary["first_delamination_load_factor"])
+    assert lams[k] == 0.25 and lams[k] < ONSET_BAND[0]
+    X, _ = _interface_points(res.problem)
+    x = X[..., 0][released[k] & ~released[k - 1]]
+    assert np.all(np.abs(x - X_EDGE45) > ELEMENT_LENGTH / 3), np.unique(np.round(x, 3))
