@@ -1021,21 +1021,18 @@ def _layer_crack_spacing(ld: schema.LayerDef, i: int, law, reinforcement, th: np
             raise InputError(f"'layers[{i}].crack_spacing': sets the crack band of a concrete layer, but layer "
                              f"'{ld.name}' has no concrete material; remove 'crack_spacing' from it")
         return law
-    if ld.crack_spacing is not None:
-        try:
-            out = replace(law, crack_spacing=float(ld.crack_spacing))
-            out.check()
-        except MaterialError as exc:
+    given = ld.crack_spacing is not None
+    s = float(ld.crack_spacing) if given else bars_crack_spacing(reinforcement, float(np.median(th))) or 0.0
+    try:
+        out = replace(law, crack_spacing=s)
+        out.check()
+    except MaterialError as exc:
+        if given:
             raise InputError(f"'layers[{i}].crack_spacing': {exc}") from None
-        return out
-    s = bars_crack_spacing(reinforcement, float(np.median(th))) or 0.0
-    if not s < law.max_band():
-        raise InputError(f"'layers[{i}]': the mean crack spacing of the bars of layer '{ld.name}', {s:.4g} (EN 1992-1-1 "
-                         f"§7.3.4), over which its cracks' opening is smeared, reaches the snap-back limit "
-                         f"2 G_F E / f_ct² = {law.max_band():.4g} of concrete '{law.name}'; check G_F and its units "
-                         "(force/length: N/mm for 'N, mm'), or give the layer a smaller crack_spacing (0: the element "
-                         "band, which the mesh must then keep below the limit)")
-    return replace(law, crack_spacing=s)
+        raise InputError(f"'layers[{i}]': the mean crack spacing of the bars of layer '{ld.name}', {s:.4g} (EN "
+                         f"1992-1-1 §7.3.4), over which its cracks' opening is smeared: {exc} (set it as the layer's "
+                         "crack_spacing); check G_F and its units (force/length: N/mm for 'N, mm')") from None
+    return out
 
 
 def crack_spacing_notes(model: Model) -> list[str]:
