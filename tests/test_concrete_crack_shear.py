@@ -1,7 +1,10 @@
-"""Shear retention across an open crack (``ConcreteLaw.shear_retention`` = β): a pure shear across a
-fully opened crack keeps the fraction β of the elastic shear stiffness (none beyond the damaged
-split's with the default 0), a closed crack its full stiffness, the tangent of the retained shear
-against central differences, the projector Q_n against its definition, and bad values refused."""
+"""Shear retention across an open crack (``ConcreteLaw.shear_retention`` = β, or with
+``aggregate_size`` = d_agg the crack's shear stiffness of Walraven's aggregate interlock at its width w
+over the band h, β = K(w) h/μ):
+a pure shear across a fully opened crack keeps the fraction β of the elastic shear stiffness (none
+beyond the damaged split's with the default 0), a closed crack its full stiffness, the tangent of
+the retained shear against central differences, the projector Q_n against its definition, and bad
+values refused."""
 import dataclasses
 
 import numpy as np
@@ -13,6 +16,14 @@ from layershell.laws.concrete import crack_shear_projector
 from layershell.material import MaterialError
 
 C30 = dataclasses.replace(PLAIN, shear_retention=0.2)
+AGG = dataclasses.replace(PLAIN, aggregate_size=16.0)  # N, mm
+
+
+def walraven_beta(width, band, f_c, mu):
+    """β = K h/μ in [0, 1], K = 1.8 w^−0.8 + (0.234 w^−0.707 − 0.20) f_c (MPa/mm, w in mm; Walraven &
+    Reinhardt 1981, d_max = 16 mm, so k_dg = 1)."""
+    K = 1.8 * width ** -0.8 + (0.234 * width ** -0.707 - 0.2) * f_c
+    return min(1.0, max(0.0, K * band / mu))
 
 H = 50.0
 
@@ -76,11 +87,26 @@ def test_a_closed_crack_has_the_full_stiffness_in_shear_too():
     np.testing.assert_allclose(s[0], comp[0] @ law.stiffness(), rtol=1e-12)
 
 
+def _width_branches(law, eps, committed, normal, implex):
+    """Per point: whether the crack strain n·ε·n is positive and whether 0 < β(w) < 1 (the kinks of
+    the aggregate-size retention), w with the damage the response acts with."""
+    _, _, tr = law.response(eps, committed, 80.0, 20.0, normal, tangent=False)
+    d, _, _ = law.damage_tension((committed if implex else tr).r_t, committed.h_t)
+    nv = np.stack([committed.n1, committed.n2, committed.n3], -1)
+    e_nn = np.einsum("na,na->n", np.einsum("ni,nj->nij", nv, nv).reshape(-1, 9)[:, [0, 4, 8, 5, 2, 1]],
+                     eps * [1, 1, 1, 1, 1, 1])
+    beta, _ = law.retention_factor(d * np.maximum(e_nn, 0.0) * committed.h_t, committed.h_t)
+    return np.column_stack([e_nn > 0, beta > 0, beta < 1])
+
+
 @pytest.mark.parametrize("implex", [False, True])
-def test_tangent_with_retained_shear_against_central_differences(implex):
+@pytest.mark.parametrize("law", [C30, AGG], ids=["beta=0.2", "d_agg=16"])
+def test_tangent_with_retained_shear_against_central_differences(implex, law):
     """Points cracked along random normals (loaded past cracking), then random strains with shear:
-    the tangent against central differences within 10⁻⁶ where the stencil stays on one branch."""
-    law, n = C30, 300
+    the tangent against central differences within 10⁻⁶ where the stencil stays on one branch
+    (with d_agg = 16 mm the crack widths, up to about 0.3 mm over bands of 20 to 80 mm, give β
+    between 0 and 1, and the variation of β with the width is in the tangent)."""
+    n = 300
     rng = np.random.default_rng(21)
     e0 = law.f_ct / law.E
     normal = np.array([_rotation(*rng.uniform(0, 2 * np.pi, 3))[:, 2] for _ in range(n)])
@@ -99,12 +125,15 @@ def test_tangent_with_retained_shear_against_central_differences(implex):
     fd = np.empty_like(D)
     same = np.ones(n, bool)
     b0 = _branches(law, eps, committed, 80.0, 20.0, normal)
+    k0 = _width_branches(law, eps, committed, normal, implex)
     for b in range(6):
         ep, em = eps.copy(), eps.copy()
         ep[:, b:b + 1] += step
         em[:, b:b + 1] -= step
         same &= np.all(_branches(law, ep, committed, 80.0, 20.0, normal) == b0, axis=1)
         same &= np.all(_branches(law, em, committed, 80.0, 20.0, normal) == b0, axis=1)
+        for e in (ep, em):
+            same &= np.all(_width_branches(law, e, committed, normal, implex) == k0, axis=1)
         fd[:, :, b] = (law.response(ep, committed, 80.0, 20.0, normal, False, **extra)[0]
                        - law.response(em, committed, 80.0, 20.0, normal, False, **extra)[0]) / (2 * step)
     ok = same & cracked
@@ -117,3 +146,54 @@ def test_tangent_with_retained_shear_against_central_differences(implex):
 def test_shear_retention_outside_0_1_is_refused(value):
     with pytest.raises(MaterialError, match="shear_retention.*must lie in"):
         dataclasses.replace(PLAIN, shear_retention=value).check()
+
+
+@pytest.mark.parametrize("implex", [False, True])
+def test_shear_across_an_opening_crack_follows_walravens_interlock(implex):
+    """Crack normal x opened to 60, 120, 200, 300 and 400 times the cracking strain (d⁺ > 0.9999)
+    over the 50 mm band: a small shear γ_xy or γ_xz is carried with [β + (1 − β)(1 − d⁺)] μ,
+    β = K(w) h/μ of Walraven's interlock stiffness (:func:`walraven_beta`) at the crack width
+    w = d⁺ ε_xx h = 0.26, 0.53, 0.88, 1.32 and 1.76 mm: 0.075 falling to 0 (K = 0 from about
+    1.5 mm at f_c = 38 MPa); the tangent's diagonal likewise."""
+    law = AGG
+    mu = law.lame()[1]
+    kept = []
+    for factor in (60.0, 120.0, 200.0, 300.0, 400.0):
+        st, eps = opened(law, np.array([1.0, 0.0, 0.0]), factor)
+        d, _, _ = law.damage_tension(st.r_t, st.h_t)
+        assert d[0] > 0.9999 and st.h_t[0] == pytest.approx(H)
+        beta = walraven_beta(d[0] * eps[0, 0] * H, H, law.f_c, mu)
+        extra = {"implex": st} if implex else {}
+        s0, D, _ = law.response(eps, st, H, H, NZ, **extra)
+        for k in (5, 4):
+            e = eps.copy()
+            e[0, k] += 1e-3 * law.f_ct / law.E
+            s1, _, _ = law.response(e, st, H, H, NZ, **extra)
+            secant = (s1 - s0)[0, k] / (mu * (e - eps)[0, k])
+            assert secant == pytest.approx(beta + (1 - beta) * (1 - d[0]), abs=1e-5)
+            assert D[0, k, k] / mu == pytest.approx(beta + (1 - beta) * (1 - d[0]), abs=1e-5)
+        kept.append(beta)
+    assert 0.07 < kept[0] < 0.08 and kept[-1] == 0.0
+    assert np.all(np.diff(kept) <= 0)
+
+
+def test_interlock_scales_with_the_aggregate_size_and_the_units():
+    """k_dg = 32/(16 + d_agg): with d_agg = 32 mm a width w keeps the β of w·2/3 at 16 mm; the same
+    concrete in kN and m gives the same β."""
+    law32 = dataclasses.replace(AGG, aggregate_size=32.0)
+    w, h = np.array([0.3, 0.6, 0.9]), np.full(3, 50.0)
+    np.testing.assert_allclose(law32.retention_factor(w, h)[0], AGG.retention_factor(w * 2 / 3, h)[0], rtol=1e-12)
+    from layershell.laws import ConcreteLaw
+    si = ConcreteLaw.from_class(30.0, 1e-3, 1.0, aggregate_size=0.016)  # kN, m
+    np.testing.assert_allclose(si.retention_factor(w * 1e-3, h * 1e-3)[0], AGG.retention_factor(w, h)[0], rtol=1e-9)
+
+
+@pytest.mark.parametrize("fields, match", [
+    ({"aggregate_size": -16.0}, "aggregate_size=-16.0 must be a positive length"),
+    ({"aggregate_size": float("nan")}, "aggregate_size=nan must be a positive length"),
+    ({"aggregate_size": 16.0, "shear_retention": 0.2}, "not both"),
+    ({"aggregate_size": 16.0, "stress_unit": 0.0}, "needs the model's units"),
+])
+def test_bad_aggregate_size_is_refused(fields, match):
+    with pytest.raises(MaterialError, match=match):
+        dataclasses.replace(PLAIN, **fields).check()

@@ -174,6 +174,11 @@ def test_strength_class_in_other_units_gives_the_same_concrete():
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nG_F = 0.001'), "layers[0]", "units"),
     (('strength_class = "C30/37"', 'strength_class = "C30/37"\nshear_retention = 1.5'), "materials.c30",
      "shear_retention=1.5 must lie in [0, 1]"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\naggregate_size = 0.0'), "materials.c30.aggregate_size",
+     "greater than 0"),
+    (('strength_class = "C30/37"', 'strength_class = "C30/37"\naggregate_size = 16.0\nshear_retention = 0.2'),
+     "materials.c30", "not both"),
+    (('grade = "B500B"', 'grade = "B500B"\naggregate_size = 16.0'), "materials.b500.aggregate_size", "unknown key"),
 ])
 def test_bad_input_names_the_field_and_the_fix(edit, field, fix):
     text = strip_model(6, 4)

@@ -908,14 +908,14 @@ def _law(name: str, md, units: str | None):
     from ..units import Units, si_factors
 
     need_units = getattr(md, "strength_class", None) or getattr(md, "f_ck", None) or getattr(md, "grade", None) \
-        or getattr(md, "fibre", None)
+        or getattr(md, "fibre", None) or getattr(md, "aggregate_size", None)
     mpa, metre = 1.0, 1.0
     if need_units:
         try:
             mpa, metre = si_factors(Units.parse(units))
         except ValueError:
-            raise InputError(f"'materials.{name}': the defaults of a strength class, grade or fibre are in MPa and "
-                             "metres, so the model needs its units: add units = 'N, mm' (or 'kN, m', ...) to "
+            raise InputError(f"'materials.{name}': the defaults of a strength class, grade or fibre and the "
+                             "interlock relation of aggregate_size are in MPa and metres, so the model needs its units: add units = 'N, mm' (or 'kN, m', ...) to "
                              "[model], or give every constant of the material in the model's units") from None
     given = {k: v for k, v in md.model_dump(exclude={"type", "strength_class", "f_ck", "grade", "fibre",
                                                        "density"}).items() if v is not None}
@@ -924,7 +924,8 @@ def _law(name: str, md, units: str | None):
             f_ck = md.f_ck if md.f_ck is not None else (_class_strength(name, md.strength_class)
                                                         if md.strength_class is not None else None)
             law = (laws.ConcreteLaw.from_class(f_ck, mpa, metre, name=name, **given) if f_ck is not None
-                   else laws.ConcreteLaw(name=name, nu=given.pop("nu", 0.2), **given))
+                   else laws.ConcreteLaw(name=name, nu=given.pop("nu", 0.2), stress_unit=mpa if need_units else 0.0,
+                                         length_unit=metre if need_units else 0.0, **given))
         elif md.type == "steel":
             law = (laws.SteelLaw.from_grade(md.grade, mpa, name=name, **given) if md.grade is not None
                    else laws.SteelLaw(name=name, **given))

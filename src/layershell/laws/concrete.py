@@ -63,6 +63,9 @@ MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
 #: with the increment Δε. 3·10⁻⁴: the TRC strip on 62.5 mm elements needs more than 10⁻⁴, and 10⁻³
 #: leaves the separated plain beam on 12 mm elements 1.2 % of its peak load (docs/concrete.md)
 INCREMENT_STIFFNESS = 3e-4
+#: the smallest crack width (mm) at which Walraven's interlock stiffness is evaluated: K(w) grows
+#: without bound as w → 0, and β = 1 is reached long before (K h/μ > 1 below about 0.05 mm)
+WALRAVEN_MIN_WIDTH = 1e-4
 NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
 
 
@@ -118,6 +121,13 @@ class ConcreteLaw:
     #: interlock, as the constant shear retention of fixed smeared cracks); 0: none beyond the
     #: split's own, since 0.2 locks the stress of a separating plain beam (docs/concrete.md, limits)
     shear_retention: float = 0.0
+    #: d_agg, the aggregate size (model length); > 0: the retention falls with the crack width w,
+    #: β = max(0, 1 − 2 w/d_agg) (:meth:`retention_factor`), in place of the constant; 0: the constant
+    aggregate_size: float = 0.0
+    #: MPa per model stress unit and m per model length unit (from_class sets them; 0: not known),
+    #: for the dimensional interlock relation of ``aggregate_size``
+    stress_unit: float = 0.0
+    length_unit: float = 0.0
     #: s, the in-plane tension band's lower bound (model length): the mean crack spacing of bars
     #: bonded in the layer (the crack band theory's band of distributed cracking); 0: the element band
     crack_spacing: float = 0.0
@@ -145,7 +155,7 @@ class ConcreteLaw:
         cls_fck, cls_eps = np.array(MC2010_EPS_C1, float).T
         eps_c1 = float(np.interp(f_ck, cls_fck, cls_eps)) * 1e-3
         s, e = float(stress_unit), float(stress_unit) * float(length_unit)
-        vals = dict(E=E_ci / s, nu=0.2, f_c=f_cm / s, f_ct=f_ctm / s, G_F=G_F / e, G_c=G_c / e, eps_c1=eps_c1)
+        vals = dict(stress_unit=float(stress_unit), length_unit=float(length_unit), E=E_ci / s, nu=0.2, f_c=f_cm / s, f_ct=f_ctm / s, G_F=G_F / e, G_c=G_c / e, eps_c1=eps_c1)
         vals.update(overrides)
         law = cls(**vals)
         law.check()
@@ -167,6 +177,15 @@ class ConcreteLaw:
         if not 0.0 <= self.shear_retention <= 1.0:
             raise MaterialError(f"concrete '{self.name}': shear_retention={self.shear_retention} must lie in "
                                 "[0, 1] (the fraction of the shear modulus an open crack keeps); 0 keeps none")
+        if not (np.isfinite(self.aggregate_size) and self.aggregate_size >= 0.0):
+            raise MaterialError(f"concrete '{self.name}': aggregate_size={self.aggregate_size} must be a positive "
+                                "length (the largest aggregate size d_agg, e.g. 16 mm); leave it out for none")
+        if self.aggregate_size > 0 and self.shear_retention > 0:
+            raise MaterialError(f"concrete '{self.name}': give shear_retention (a constant β) or aggregate_size "
+                                "(β falling with the crack width), not both")
+        if self.aggregate_size > 0 and not (self.stress_unit > 0 and self.length_unit > 0):
+            raise MaterialError(f"concrete '{self.name}': aggregate_size needs the model's units (its interlock "
+                                "relation is in MPa and mm): add units = 'N, mm' (or 'kN, m', ...) to [model]")
         if not (np.isfinite(self.crack_spacing) and self.crack_spacing >= 0.0):
             raise MaterialError(f"concrete '{self.name}': crack_spacing={self.crack_spacing} must be a length >= 0 "
                                 "(the mean spacing of the cracks the bars distribute); 0 keeps the element band")
@@ -326,14 +345,40 @@ class ConcreteLaw:
         D = self._tangent(u, u.d_t, u.d_c, True, u.g_t, u.g_c, e_t)
         return sigma, (D if ret is None else D + ret[1]), u.trial
 
+    def retention_factor(self, width, band):
+        """β and dβ/dw (n,) at the crack widths ``width`` over the bands ``band`` (model length).
+
+        With ``aggregate_size`` d_agg > 0: β = K(w) h/μ clipped to [0, 1], K the crack's shear
+        stiffness, the slope of Walraven & Reinhardt's (1981) aggregate interlock relation
+        τ = −f_c/30 + [1.8 w^−0.8 + (0.234 w^−0.707 − 0.20) f_c] δ (MPa, mm; gravel concrete,
+        d_max 16 mm) at the width w k_dg (k_dg = 32/(16 + d_agg), fib MC2010 7.3.3.2): the band's
+        shear strain γ is the slip δ = γ h of its crack, so τ = K δ = (K h/μ) μ γ. Else the constant
+        ``shear_retention`` (dβ/dw = 0)."""
+        w = np.asarray(width, float)
+        if not self.aggregate_size > 0:
+            return np.full(w.shape, self.shear_retention), np.zeros(w.shape)
+        mm, mpa = 1e-3 / self.length_unit, 1.0 / self.stress_unit  # model length per mm, stress per MPa
+        k_dg = 32.0 / (16.0 + self.aggregate_size / mm)
+        we = np.maximum(w / mm * k_dg, WALRAVEN_MIN_WIDTH)
+        fc = self.f_c / mpa
+        K = 1.8 * we ** -0.8 + (0.234 * we ** -0.707 - 0.2) * fc  # MPa/mm
+        dK = (-1.44 * we ** -1.8 - 0.165438 * we ** -1.707 * fc) * k_dg / mm  # MPa/mm per model length
+        scale = np.asarray(band, float) * (mpa / mm) / self.lame()[1]  # h/μ in mm/MPa
+        beta = K * scale
+        inside = (beta > 0.0) & (beta < 1.0) & (w / mm * k_dg > WALRAVEN_MIN_WIDTH)
+        return np.clip(beta, 0.0, 1.0), np.where(inside, dK * scale, 0.0)
+
     def _retention(self, u, committed, d_t, tangent: bool, variation: bool):
-        """The shear an open crack retains, β d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None
-        (tangent False); None where no point retains any (β = 0 or no committed crack):
+        """The shear an open crack retains, β(w) d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None
+        (tangent False); None where no point retains any (no retention or no committed crack):
         Q_n(A) = (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n, the shear traction of σ̄⁺ on the plane
         of the committed crack normal n (zero where the committed state is uncracked, and where the
-        crack is closed: σ̄⁺ = 0); β = ``shear_retention``. ``variation``: the tangent adds
-        β Q_n(σ̄⁺) ⊗ dd⁺/dε (the implicit update), else d⁺ is frozen (IMPL-EX)."""
-        cracked = np.flatnonzero(committed.h_t > 0) if self.shear_retention > 0 else np.zeros(0, int)
+        crack is closed: σ̄⁺ = 0); β from :meth:`retention_factor` of the crack width
+        w = d⁺ ⟨n·ε·n⟩ h (:meth:`crack`, with the acting d⁺). ``variation``: the tangent adds the
+        variation of d⁺ (β Q_n(σ̄⁺) ⊗ dd⁺/dε and its part of dβ/dε: the implicit update), else d⁺
+        is frozen (IMPL-EX) and dβ/dε = β'(w) d⁺ h H(ε_nn) n ⊗ n."""
+        retains = self.shear_retention > 0 or self.aggregate_size > 0
+        cracked = np.flatnonzero(committed.h_t > 0) if retains else np.zeros(0, int)
         if cracked.size == 0:
             return None
         n = u.w.shape[0]
@@ -343,16 +388,26 @@ class ConcreteLaw:
         Q = crack_shear_projector(nv)
         sp = np.einsum("nk,nka->na", np.maximum(u.w[cracked], 0.0), u.P[cracked])
         qs = np.einsum("nab,nb->na", Q, sp)
-        bd = self.shear_retention * d_t[cracked]
+        lam, mu = self.lame()
+        wc = u.w[cracked]
+        e_nn = (wc[:, 2] - lam * wc.sum(axis=1) / (3.0 * lam + 2.0 * mu)) / (2.0 * mu)  # ε_max
+        v = u.V[cracked][:, :, 2]
+        nn = spectral.dyad(v, v)  # dε_max/dε for engineering shears
+        d, h = d_t[cracked], committed.h_t[cracked]
+        beta, dbeta = self.retention_factor(d * np.maximum(e_nn, 0.0) * h, h)
+        bd = beta * d
         ds[cracked] = bd[:, None] * qs
         if tangent:
             sub = SimpleNamespace(V=u.V[cracked], w=u.w[cracked], P=u.P[cracked], sbar=u.sbar[cracked])
             m = cracked.size
             dpos = self._tangent(sub, np.zeros(m), np.ones(m), False)  # dσ̄⁺/dε
             dD[cracked] = bd[:, None, None] * np.einsum("nab,nbc->nac", Q, dpos)
+            dw = (d * h * (e_nn > 0))[:, None] * nn  # dw/dε at frozen d⁺
+            dd = np.zeros((m, 6))
             if variation:
-                row = np.einsum("nk,nka->na", u.g_t[cracked], u.P[cracked]) * spectral.WEIGHT
-                dD[cracked] += self.shear_retention * qs[:, :, None] * (row @ self.stiffness())[:, None, :]
+                dd = (np.einsum("nk,nka->na", u.g_t[cracked], u.P[cracked]) * spectral.WEIGHT) @ self.stiffness()
+                dw = dw + (np.maximum(e_nn, 0.0) * h)[:, None] * dd
+            dD[cracked] += qs[:, :, None] * (beta[:, None] * dd + (d * dbeta)[:, None] * dw)[:, None, :]
         return ds, dD
 
     def _update(self, eps, committed: ConcreteState, h_in, h_z, normal) -> SimpleNamespace:
@@ -386,7 +441,7 @@ class ConcreteLaw:
         nvec = np.stack([committed.n1, committed.n2, committed.n3], -1)
         nvec[on] = v_new
         trial = ConcreteState(r_t, r_c, h_t, h_in.copy(), nvec[:, 0], nvec[:, 1], nvec[:, 2])
-        return SimpleNamespace(trial=trial, sbar=sbar, w=w, V=V, P=P, d_t=d_t, d_c=d_c,
+        return SimpleNamespace(trial=trial, eps=eps, sbar=sbar, w=w, V=V, P=P, d_t=d_t, d_c=d_c,
                                g_t=(ddt_r * load_t)[:, None] * dtau_t, g_c=ddc, on=on, ddt_h=ddt_h, dh_row=dh_row)
 
     def _tangent(self, u, d_t, d_c, rank2: bool, g_t=None, g_c=None, e_t=None) -> np.ndarray:
