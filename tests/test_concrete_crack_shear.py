@@ -16,7 +16,7 @@ from layershell.laws.concrete import crack_shear_projector
 from layershell.material import MaterialError
 
 C30 = dataclasses.replace(PLAIN, shear_retention=0.2)
-AGG = dataclasses.replace(PLAIN, aggregate_size=16.0)  # N, mm
+AGG = dataclasses.replace(PLAIN, aggregate_size=16.0, crack_spacing=40.0)  # N, mm; bars hold the cracks
 
 
 def walraven_beta(width, band, f_c, mu):
@@ -154,7 +154,7 @@ def test_shear_across_an_opening_crack_follows_walravens_interlock(implex):
     over the 50 mm band: a small shear γ_xy or γ_xz is carried with [β + (1 − β)(1 − d⁺)] μ,
     β = K(w) h/μ of Walraven's interlock stiffness (:func:`walraven_beta`) at the crack width
     w = d⁺ ε_xx h = 0.26, 0.53, 0.88, 1.32 and 1.76 mm: 0.075 falling to 0 (K = 0 from about
-    1.5 mm at f_c = 38 MPa); the tangent's diagonal likewise."""
+    1.6 mm at f_c = 38 MPa); the tangent's diagonal likewise."""
     law = AGG
     mu = law.lame()[1]
     kept = []
@@ -186,6 +186,17 @@ def test_interlock_scales_with_the_aggregate_size_and_the_units():
     from layershell.laws import ConcreteLaw
     si = ConcreteLaw.from_class(30.0, 1e-3, 1.0, aggregate_size=0.016)  # kN, m
     np.testing.assert_allclose(si.retention_factor(w * 1e-3, h * 1e-3)[0], AGG.retention_factor(w, h)[0], rtol=1e-9)
+
+
+def test_interlock_needs_a_crack_spacing():
+    """Without bars holding its cracks (crack_spacing = 0) a crack keeps no interlock: a shear across
+    it is carried with (1 − d⁺) μ only, as without retention."""
+    law = dataclasses.replace(AGG, crack_spacing=0.0)
+    st, eps = opened(law, np.array([1.0, 0.0, 0.0]), 60.0)
+    d, _, _ = law.damage_tension(st.r_t, st.h_t)
+    _, D, _ = law.response(eps, st, H, H, NZ)
+    assert D[0, 5, 5] / law.lame()[1] == pytest.approx(1 - d[0], abs=1e-6)
+    assert AGG.response(eps, st, H, H, NZ)[1][0, 5, 5] / law.lame()[1] > 0.07
 
 
 @pytest.mark.parametrize("fields, match", [

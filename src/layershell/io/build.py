@@ -915,8 +915,9 @@ def _law(name: str, md, units: str | None):
             mpa, metre = si_factors(Units.parse(units))
         except ValueError:
             raise InputError(f"'materials.{name}': the defaults of a strength class, grade or fibre and the "
-                             "interlock relation of aggregate_size are in MPa and metres, so the model needs its units: add units = 'N, mm' (or 'kN, m', ...) to "
-                             "[model], or give every constant of the material in the model's units") from None
+                             "interlock relation of aggregate_size are in MPa and metres, so the model needs its "
+                             "units: add units = 'N, mm' (or 'kN, m', ...) to [model], or give every constant of "
+                             "the material in the model's units") from None
     given = {k: v for k, v in md.model_dump(exclude={"type", "strength_class", "f_ck", "grade", "fibre",
                                                        "density"}).items() if v is not None}
     try:
@@ -1037,7 +1038,8 @@ def _layer_crack_spacing(ld: schema.LayerDef, i: int, law, reinforcement, th: np
 
 
 def crack_spacing_notes(model: Model) -> list[str]:
-    """A note per concrete layer with steel bars whose crack band is the element's: where the bars
+    """A note per concrete layer with ``aggregate_size`` but no crack spacing (the interlock then does
+    not act), and per concrete layer with steel bars whose crack band is the element's: where the bars
     are given by area only (no crack spacing known), and where ``crack_spacing = 0`` leaves elements
     with a band shorter than :data:`BAND_PER_SPACING` of the bars' mean crack spacing (EN 1992-1-1
     §7.3.4): with perfectly bonded bars every such element cracks and keeps the tension of its
@@ -1046,6 +1048,10 @@ def crack_spacing_notes(model: Model) -> list[str]:
 
     notes = []
     for k, ly in enumerate(model.layers):
+        if getattr(ly.law, "aggregate_size", 0.0) > 0 and ly.law.crack_spacing == 0.0:
+            notes.append(f"layer '{ly.name}': aggregate_size has no effect here: the aggregate interlock acts where "
+                         "bonded bars hold the cracks, in layers with a crack spacing (bars by bar_diameter and "
+                         "spacing, or crack_spacing); this layer's cracks separate freely (docs/concrete.md)")
         bars, by_area = _steel_bars(ly.reinforcement)
         if getattr(ly.law, "crack_spacing", None) != 0.0 or not (bars or by_area):
             continue

@@ -324,8 +324,8 @@ class ConcreteMat(Strict):
     shear_retention: float | None = Field(None, description=(
         "fraction 0..1 of the shear modulus an open crack keeps across its plane; default 0"))
     aggregate_size: PositiveFloat | None = Field(None, description=(
-        "largest aggregate size d_agg (length, e.g. 16 mm): an open crack keeps the fraction "
-        "max(0, 1 - 2 w/d_agg) of the shear modulus across its plane, w its width; instead of shear_retention"))
+        "largest aggregate size d_agg (length, e.g. 16 mm): an open crack keeps Walraven's aggregate "
+        "interlock, a shear stiffness that falls with its width; instead of shear_retention; needs [model] units"))
     density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
     @model_validator(mode="after")

@@ -30,8 +30,12 @@ concrete) keeps the element band. Crushing uses h_in: it localises
 across an in-plane element length (compression normal to the mid-surface is not a shell's
 failure mode).
 
-Optional shear retention (``shear_retention`` = β, default 0): an open crack keeps β μ across the
-plane of its fixed normal n, σ += β d⁺ Q_n(σ̄⁺) (:func:`crack_shear_projector`). Increment stiffness
+Optional shear retention: an open crack keeps β μ across the plane of its fixed normal n,
+σ += β d⁺ Q_n(σ̄⁺) (:func:`crack_shear_projector`), β the constant ``shear_retention`` (default 0),
+or with ``aggregate_size`` the aggregate interlock of Walraven & Reinhardt (1981) at the crack's
+width w = d⁺ ⟨n·ε·n⟩ h (:meth:`ConcreteLaw.crack`): β = K(w) h/μ, K the crack's shear stiffness
+per slip, which falls with the opening and vanishes at about 1.6 mm for C30/37
+(:meth:`ConcreteLaw.retention_factor`). Increment stiffness
 (``strain_n`` given, as by the layer elements): σ += k d_n C0 (ε − ε_n) with the committed strain
 ε_n and damage d_n, k = :data:`INCREMENT_STIFFNESS`: an opened crack makes all three principal
 effective stresses positive (the Poisson part of its strain), so d⁺ → 1 leaves no stiffness in
@@ -64,7 +68,7 @@ MAX_IMPLEX_DAMAGE = 1.0 - 1e-6
 #: leaves the separated plain beam on 12 mm elements 1.2 % of its peak load (docs/concrete.md)
 INCREMENT_STIFFNESS = 3e-4
 #: the smallest crack width (mm) at which Walraven's interlock stiffness is evaluated: K(w) grows
-#: without bound as w → 0, and β = 1 is reached long before (K h/μ > 1 below about 0.05 mm)
+#: without bound as w → 0 (K = 9·10³ MPa/mm here, so β = K h/μ = 1 for any band above 2 mm)
 WALRAVEN_MIN_WIDTH = 1e-4
 NAKAMURA_HIGAI = 8.8  # G_c = 8.8 √f_c N/mm (f_c in MPa): Nakamura & Higai (2001), ASCE SP, 471-487
 
@@ -121,8 +125,9 @@ class ConcreteLaw:
     #: interlock, as the constant shear retention of fixed smeared cracks); 0: none beyond the
     #: split's own, since 0.2 locks the stress of a separating plain beam (docs/concrete.md, limits)
     shear_retention: float = 0.0
-    #: d_agg, the aggregate size (model length); > 0: the retention falls with the crack width w,
-    #: β = max(0, 1 − 2 w/d_agg) (:meth:`retention_factor`), in place of the constant; 0: the constant
+    #: d_agg, the largest aggregate size (model length); > 0: β falls with the crack width as
+    #: Walraven's aggregate interlock (:meth:`retention_factor`), in place of the constant; 0: the
+    #: constant; acts where ``crack_spacing`` > 0 (bars hold the cracks)
     aggregate_size: float = 0.0
     #: MPa per model stress unit and m per model length unit (from_class sets them; 0: not known),
     #: for the dimensional interlock relation of ``aggregate_size``
@@ -155,7 +160,8 @@ class ConcreteLaw:
         cls_fck, cls_eps = np.array(MC2010_EPS_C1, float).T
         eps_c1 = float(np.interp(f_ck, cls_fck, cls_eps)) * 1e-3
         s, e = float(stress_unit), float(stress_unit) * float(length_unit)
-        vals = dict(stress_unit=float(stress_unit), length_unit=float(length_unit), E=E_ci / s, nu=0.2, f_c=f_cm / s, f_ct=f_ctm / s, G_F=G_F / e, G_c=G_c / e, eps_c1=eps_c1)
+        vals = dict(E=E_ci / s, nu=0.2, f_c=f_cm / s, f_ct=f_ctm / s, G_F=G_F / e, G_c=G_c / e, eps_c1=eps_c1,
+                    stress_unit=float(stress_unit), length_unit=float(length_unit))
         vals.update(overrides)
         law = cls(**vals)
         law.check()
@@ -346,14 +352,16 @@ class ConcreteLaw:
         return sigma, (D if ret is None else D + ret[1]), u.trial
 
     def retention_factor(self, width, band):
-        """β and dβ/dw (n,) at the crack widths ``width`` over the bands ``band`` (model length).
+        """β and dβ/dw (n,) at the crack widths ``width`` over the bands ``band`` (model length)
+        (dβ/dw = 0 where β is clipped).
 
         With ``aggregate_size`` d_agg > 0: β = K(w) h/μ clipped to [0, 1], K the crack's shear
         stiffness, the slope of Walraven & Reinhardt's (1981) aggregate interlock relation
         τ = −f_c/30 + [1.8 w^−0.8 + (0.234 w^−0.707 − 0.20) f_c] δ (MPa, mm; gravel concrete,
         d_max 16 mm) at the width w k_dg (k_dg = 32/(16 + d_agg), fib MC2010 7.3.3.2): the band's
         shear strain γ is the slip δ = γ h of its crack, so τ = K δ = (K h/μ) μ γ. Else the constant
-        ``shear_retention`` (dβ/dw = 0)."""
+        ``shear_retention`` (dβ/dw = 0). The interlock acts in layers with a crack spacing only
+        (:meth:`_retention`)."""
         w = np.asarray(width, float)
         if not self.aggregate_size > 0:
             return np.full(w.shape, self.shear_retention), np.zeros(w.shape)
@@ -370,14 +378,18 @@ class ConcreteLaw:
 
     def _retention(self, u, committed, d_t, tangent: bool, variation: bool):
         """The shear an open crack retains, β(w) d⁺ Q_n(σ̄⁺) (n, 6), and its tangent (n, 6, 6) or None
-        (tangent False); None where no point retains any (no retention or no committed crack):
+        (tangent False); None where no point retains any (no retention or no committed crack). The
+        interlock of ``aggregate_size`` needs the crack held by bonded bars (``crack_spacing`` > 0):
+        Walraven's shear comes with a normal compression across the crack that a restraint supplies,
+        and a free crack in plain concrete opens instead (its retention would lock the stress of a
+        separating beam, docs/concrete.md):
         Q_n(A) = (A n) ⊗ n + n ⊗ (A n) − 2 (n·A·n) n ⊗ n, the shear traction of σ̄⁺ on the plane
         of the committed crack normal n (zero where the committed state is uncracked, and where the
         crack is closed: σ̄⁺ = 0); β from :meth:`retention_factor` of the crack width
         w = d⁺ ⟨n·ε·n⟩ h (:meth:`crack`, with the acting d⁺). ``variation``: the tangent adds the
         variation of d⁺ (β Q_n(σ̄⁺) ⊗ dd⁺/dε and its part of dβ/dε: the implicit update), else d⁺
         is frozen (IMPL-EX) and dβ/dε = β'(w) d⁺ h H(ε_nn) n ⊗ n."""
-        retains = self.shear_retention > 0 or self.aggregate_size > 0
+        retains = self.shear_retention > 0 or (self.aggregate_size > 0 and self.crack_spacing > 0)
         cracked = np.flatnonzero(committed.h_t > 0) if retains else np.zeros(0, int)
         if cracked.size == 0:
             return None
@@ -388,11 +400,8 @@ class ConcreteLaw:
         Q = crack_shear_projector(nv)
         sp = np.einsum("nk,nka->na", np.maximum(u.w[cracked], 0.0), u.P[cracked])
         qs = np.einsum("nab,nb->na", Q, sp)
-        lam, mu = self.lame()
-        wc = u.w[cracked]
-        e_nn = (wc[:, 2] - lam * wc.sum(axis=1) / (3.0 * lam + 2.0 * mu)) / (2.0 * mu)  # ε_max
-        v = u.V[cracked][:, :, 2]
-        nn = spectral.dyad(v, v)  # dε_max/dε for engineering shears
+        nn = spectral.dyad(nv, nv)  # d(n·ε·n)/dε for engineering shears
+        e_nn = np.einsum("na,na->n", nn, u.eps[cracked])
         d, h = d_t[cracked], committed.h_t[cracked]
         beta, dbeta = self.retention_factor(d * np.maximum(e_nn, 0.0) * h, h)
         bd = beta * d
