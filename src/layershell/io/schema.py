@@ -325,7 +325,8 @@ class ConcreteMat(Strict):
         "fraction 0..1 of the shear modulus an open crack keeps across its plane; default 0"))
     aggregate_size: PositiveFloat | None = Field(None, description=(
         "largest aggregate size d_agg (length, e.g. 16 mm): an open crack keeps Walraven's aggregate "
-        "interlock, a shear stiffness that falls with its width; instead of shear_retention; needs [model] units"))
+        "interlock, a shear stiffness that falls with its width, in layers whose bars hold the cracks (a crack "
+        "spacing); instead of shear_retention; needs [model] units"))
     density: float = Field(0.0, ge=0, description="mass per volume (for gravity loads)")
 
     @model_validator(mode="after")
