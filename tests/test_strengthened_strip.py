@@ -64,7 +64,7 @@ def shear_resistance() -> float:
 def test_plate_strain_follows_the_section_analysis(tmp_path):
     """Midspan plate strain against the section's at the same moment: within 1 % uncracked and
     within 3 % from 37 kNm/m (the cracks formed) to 20 mm deflection; before, while the cracks
-    spread over the elements of the constant moment, the FE strain lags by up to 22 %."""
+    spread over the elements of the constant moment, the FE strain lags by up to 25 %."""
     res, M, eps = strip_run(7)
     M = M * WIDTH * 1e3  # N·mm on the 250 mm strip
     sec = strengthened_section()
@@ -85,12 +85,13 @@ def test_plate_strain_follows_the_section_analysis(tmp_path):
 
 @pytest.mark.slow
 def test_strip_with_aggregate_interlock_converges_below_the_shear_resistance():
-    """On elements of about 440, 250 and 125 mm along the half span (the example's in the middle;
-    crack bands 316-361 mm, then the bars' 241 mm) every run reaches 20 mm, the moment there (the
-    largest) within 1 % of the three's mean and below the shear resistance of EN 1992-1-1 (6.2a),
+    """On 4, 7 and 14 elements along the half span (the example's in the middle; shear span
+    elements of 437.5, 219 and 125 mm, crack bands 316-361 mm, then the bars' 241 mm) every run
+    reaches 20 mm, the moment there (the largest) within 1 % of the three's mean and below the
+    shear resistance of EN 1992-1-1 (6.2a),
     V_Rc = 97.6 kN/m (the shear span's shear is the moment per metre of span); the plate passes
     Teng's IC debonding strain, 0.00189, within 5 % of the moment at which the perfectly bonded
-    section does (68.1 kNm/m), and nothing debonds (docs/concrete.md, limits)."""
+    section does (68.2 kNm/m), and nothing debonds (docs/concrete.md, limits)."""
     teng = teng_ic_strain(C30.f_c, E_F, T_F, WIDTH, WIDTH)
     sec = moment_curvature(strengthened_section(), np.linspace(1e-8, 6e-5, 6000))
     m_teng = np.interp(teng, sec.eps_points[:, -1], sec.M) / WIDTH / 1e3  # kNm/m
@@ -100,7 +101,8 @@ def test_strip_with_aggregate_interlock_converges_below_the_shear_resistance():
         assert res.converged and res.summary["steps"][-1]["load_factor"] == pytest.approx(1.0)
         assert np.argmax(M) == M.size - 1
         last.append(M[-1])
-        assert np.interp(teng, eps, M) == pytest.approx(m_teng, rel=0.05)
+        j = int(np.argmax(eps >= teng))  # the first step past Teng's strain
+        assert j > 0 and np.interp(teng, eps[j - 1:j + 1], M[j - 1:j + 1]) == pytest.approx(m_teng, rel=0.05)
         assert max(s["probes"]["debonded"] for s in res.summary["steps"]) == 0.0
     last = np.array(last)
     assert np.all(np.abs(last / last.mean() - 1.0) < 0.01), last

@@ -370,7 +370,7 @@ class ConcreteLaw:
         we = np.maximum(w / mm * k_dg, WALRAVEN_MIN_WIDTH)
         fc = self.f_c / mpa
         K = 1.8 * we ** -0.8 + (0.234 * we ** -0.707 - 0.2) * fc  # MPa/mm
-        dK = (-1.44 * we ** -1.8 - 0.165438 * we ** -1.707 * fc) * k_dg / mm  # MPa/mm per model length
+        dK = (-1.8 * 0.8 * we ** -1.8 - 0.234 * 0.707 * we ** -1.707 * fc) * k_dg / mm  # MPa/mm per model length
         scale = np.asarray(band, float) * (mpa / mm) / self.lame()[1]  # h/μ in mm/MPa
         beta = K * scale
         inside = (beta > 0.0) & (beta < 1.0) & (w / mm * k_dg > WALRAVEN_MIN_WIDTH)
