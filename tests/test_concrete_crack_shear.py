@@ -25,6 +25,7 @@ def walraven_beta(width, band, f_c, mu):
     K = 1.8 * width ** -0.8 + (0.234 * width ** -0.707 - 0.2) * f_c
     return min(1.0, max(0.0, K * band / mu))
 
+
 H = 50.0
 
 
@@ -93,8 +94,7 @@ def _width_branches(law, eps, committed, normal, implex):
     _, _, tr = law.response(eps, committed, 80.0, 20.0, normal, tangent=False)
     d, _, _ = law.damage_tension((committed if implex else tr).r_t, committed.h_t)
     nv = np.stack([committed.n1, committed.n2, committed.n3], -1)
-    e_nn = np.einsum("na,na->n", np.einsum("ni,nj->nij", nv, nv).reshape(-1, 9)[:, [0, 4, 8, 5, 2, 1]],
-                     eps * [1, 1, 1, 1, 1, 1])
+    e_nn = np.einsum("na,na->n", np.einsum("ni,nj->nij", nv, nv).reshape(-1, 9)[:, [0, 4, 8, 5, 2, 1]], eps)
     beta, _ = law.retention_factor(d * np.maximum(e_nn, 0.0) * committed.h_t, committed.h_t)
     return np.column_stack([e_nn > 0, beta > 0, beta < 1])
 
