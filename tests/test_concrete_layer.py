@@ -451,9 +451,11 @@ def test_load_displacement_figure_marks_cracking_and_yielding():
 
 
 def test_elongated_elements_of_a_concrete_layer_are_warned():
-    """Square elements: no note; elements four times as long as wide: a note naming the layer,
-    the ratio and the fix."""
+    """Square elements and elements twice as long as wide (to round-off): no note; elements four
+    times as long as wide: a note naming the layer, the ratio and the fix."""
     assert not [w for w in build(parse(strip_model(6, 4))).warnings if "elongated" in w]
+    twice = strip_model(6, 4).replace("ly = 250.0", "ly = 124.99999999999999")  # 250 / ly = 2 (1 + 1.1e-16)
+    assert not [w for w in build(parse(twice)).warnings if "elongated" in w]
     notes = [w for w in build(parse(strip_model(6, 4).replace("ly = 250.0", "ly = 62.5"))).warnings
              if "elongated" in w]
     assert len(notes) == 1 and "'slab'" in notes[0] and "4 times" in notes[0] and "factor 2" in notes[0]
