@@ -14,14 +14,14 @@ from test_path_following import _path_stand_ins, _stand_in_problem
 MODEL = Path(__file__).parent / "models" / "rc_slab_mcneice_pressure.toml"
 
 
-def _material_stand_in(ledger: dict):
-    """The two-DOF stand-in problem with layers whose materials have a history: their dissipation
-    ``ledger["committed"]``, and ``ledger["trial"]`` in the trial state of the last attempt;
-    a commit takes the trial one."""
+def _material_stand_in(ledger: dict, integration: str = "implicit"):
+    """The two-DOF stand-in problem with layers whose materials have a history (integrated by
+    ``integration``): their dissipation ``ledger["committed"]``, and ``ledger["trial"]`` in the
+    trial state of the last attempt; a commit takes the trial one."""
     from types import SimpleNamespace
 
     pb = _stand_in_problem()
-    pb.assembler = SimpleNamespace(materials=SimpleNamespace(active=True),
+    pb.assembler = SimpleNamespace(materials=SimpleNamespace(active=True, integration=integration),
                                    material_dissipation=lambda u=None: ledger["committed" if u is None else "trial"])
     pb.commit = lambda u, lam: ledger.update(committed=ledger["trial"])
     pb.op = SimpleNamespace(independent=np.arange(2))
@@ -84,6 +84,47 @@ def test_damage_booked_adds_the_materials_to_the_interfaces(monkeypatch):
     ledger["trial"] = 2.0
     assert al.elastic_unloading(pb, -0.01, -np.ones(2), None, 2.0, np.zeros(2))
     assert not al.elastic_unloading(pb, -0.01, -np.ones(2), None, None, np.zeros(2))  # no ledger at all
+
+
+@pytest.mark.parametrize("integration, modes", [("implicit", ["arc", "dissipation", "dissipation"]),
+                                                ("implex", ["arc", "arc", "arc"])])
+def test_implex_layers_alone_keep_the_arc_length_and_the_work_criterion(monkeypatch, integration, modes):
+    """Arc-length increments that dissipate (ΔG = 1 against the elastic energy 0.05 of the
+    stand-in) switch to the dissipation constraint (Verhoosel et al. 2009), unless only IMPL-EX
+    layers dissipate (implex_only): their damage in an increment is extrapolated before it, and
+    on McNeice's cracking slab the constraint met it only by lowering λ. There every increment
+    takes its direction from the work criterion (no previous increment passed to the
+    attempt), which on the slab kept the path rising past the IMPL-EX catch-up increments (λ
+    falling at a nearly constant deflection) that the previous direction had turned into
+    elastic unloading from 8.2 kN."""
+    from layershell.solver import arclength as al
+    from layershell.solver.newton import NewtonSettings
+
+    ledger = {"committed": 0.0, "trial": 0.0}
+    tried = []
+
+    def attempt(problem, u, lam, size, mode, du_prev, *a, **k):
+        tried.append((mode, du_prev is None))
+        ledger["trial"] = ledger["committed"] + 1.0
+        return al.Attempt(True, u + 1e-3, lam + 0.01, 3, [1e-10])
+
+    _path_stand_ins(monkeypatch, al, arc_attempt=attempt, arc_weights=lambda p: 1.0,
+                    dissipation_increment=lambda *a: 1.0, conjugates=lambda p, u: (0.1, 0.0),
+                    full_weights=lambda p: np.ones(2))
+    pb = _material_stand_in(ledger, integration)
+    assert al.implex_only(pb) == (integration == "implex")
+    ps = al.PathSettings(control="arc_length", lambda_end=1.0, increment=0.25, arc_length=1.0, max_cuts=2,
+                         jump_area=None, jump_ratio=None, energy_tolerance=None, max_steps=3)
+    st0 = al.PathState(mode="arc", size=0.1, arc_length=0.1, lam_peak=0.5, arc_length0=1.0, du_prev=np.ones(2))
+    steps = list(al.path_steps(pb, NewtonSettings(), ps, lam0=0.5, u0=np.zeros(2), state=st0))
+    assert [s.load_factor for s in steps] == pytest.approx([0.51, 0.52, 0.53])
+    assert [m for m, _ in tried] == modes
+    if integration == "implex":
+        assert [fresh for _, fresh in tried] == [False, True, True]
+    from types import SimpleNamespace
+
+    pb.interfaces = SimpleNamespace(cohesive=lambda: True)  # with cohesive interfaces: as before
+    assert not al.implex_only(pb)
 
 
 def _slab_curve(replace: dict[str, str]):

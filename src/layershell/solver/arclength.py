@@ -818,7 +818,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # elements: 50 % of its interface debonded, then unloaded and "failed")
                 st.mode, st.size, st.changed = "arc", st.arc_length, True
                 continue
-            if st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0:
+            if (st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0
+                    and not implex_only(problem)):
                 # e.g. at a peak where damage starts: the arc length cannot pick the branch, the
                 # dissipation constraint can (its predictor sign follows from the tangent)
                 tried_dissipation = True
@@ -891,8 +892,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         _next_size(problem, st, ps, att, abs(dlam) if st.mode == "load" else st.size, cuts, e_rel, dG, du, conj,
                    friction, displacement_path, (inc_min, inc_max, dl_min, dl_max))
+        if st.mode == "dissipation" and implex_only(problem):
+            st.mode, st.size = "arc", st.arc_length  # the arc length alone (implex_only)
         st.du_prev = du
-        st.changed = resolves > 0  # the next direction by the work criterion
+        # the next direction by the work criterion: after a re-solution (debonding), and always on
+        # IMPL-EX layers alone (implex_only), whose tangent within an increment is positive definite
+        st.changed = resolves > 0 or implex_only(problem)
         _stretch_bookkeeping(st, n, lam, att.lam, cuts, arc, warns)
         u, lam = att.u, att.lam
         st.reaction = conj[1] if conj is not None else math.nan
@@ -1447,6 +1452,22 @@ def elastic_unloading(problem: Problem, dlam: float, du: np.ndarray, ledger0: tu
         return False
     dD, damage = damage_booked(problem, ledger0, mat0, u)
     return dD is not None and float(problem.F_scaled @ du) < 0.0 and not beyond_round_off(dD, damage)
+
+
+def implex_only(problem: Problem) -> bool:
+    """Do only layers integrated by IMPL-EX dissipate (no cohesive interface)? Then the arc length
+    alone follows the path, without Verhoosel's switch to the dissipation constraint. Within an
+    increment such a layer acts with the damage extrapolated from the last increments, so the
+    damage the increment adds is set before its iterations, and the constraint ΔG = Δτ can only
+    choose λ to match it: on McNeice's cracking slab by arc length every dissipation-controlled
+    increment from 7.2 kN on converged with λ falling (from λ = 0.600, Δτ = 11.4 to 0.582, half
+    of it to 0.286, and so on down with each cut), its layers booking no dissipation, while the
+    arc length's increments rise with load control's in 3 iterations each."""
+    mats = getattr(getattr(problem, "assembler", None), "materials", None)
+    if mats is None or not mats.active or getattr(mats, "integration", "") != "implex":
+        return False
+    cohesive = getattr(getattr(problem, "interfaces", None), "cohesive", None)
+    return not (cohesive is not None and cohesive())
 
 
 def material_booked(problem: Problem, u: np.ndarray | None = None) -> float | None:
