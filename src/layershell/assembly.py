@@ -411,8 +411,13 @@ class Assembler:
         self._layers(u_full, np.zeros(self.dm.n_full), None)
         return self.materials.implex_error()
 
-    def material_dissipation(self) -> float:
-        return self.materials.dissipation()
+    def material_dissipation(self, u_full: np.ndarray | None = None) -> float:
+        """Energy the layers' materials have dissipated: in the committed state, or where
+        ``u_full`` is given in the trial state at ``u_full`` (before it is committed)."""
+        if u_full is None or not self.materials.active:
+            return self.materials.dissipation()
+        self._layers(u_full, np.zeros(self.dm.n_full), None)
+        return self.materials.dissipation(trial=True)
 
     def material_events(self) -> dict[str, bool]:
         return self.materials.events()

@@ -94,11 +94,11 @@ class MaterialStates:
         self.model.point_states.clear()
         self.model.point_states.update(states)
 
-    def dissipation(self) -> float:
-        """Energy dissipated so far (committed state): Σ dissipation per volume × dV over the
-        points (sheets: × A_s dA)."""
+    def dissipation(self, trial: bool = False) -> float:
+        """Energy dissipated so far: Σ dissipation per volume × dV over the points (sheets: ×
+        A_s dA), of the committed state, or (``trial``) of the last evaluation's trial state."""
         total = 0.0
-        for i, st in self.committed.items():
+        for i, st in (self.trial if trial else self.committed).items():
             ref = self.blocks[i].ref
             if ref.law is not None:
                 total += float(ref.law.dissipation(st.bulk) @ ref.base.dV.ravel())

@@ -734,6 +734,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # the interfaces' ledger at the start (all dissipation, by damage): CONSTRAINT_BOOKED, unloading
         ledger0 = (ledger_booked(problem)
                    if on_step_end is not None and hasattr(problem.interfaces, "dissipation") else None)
+        mat0 = material_booked(problem)  # the layers' materials' (cracking, yielding) at the start
         while True:
             snap = problem.snapshot() if on_step_end is not None else None
             att, to_end = _try_increment(problem, st, s, ps, u, lam, cuts, f_itf0)
@@ -769,8 +770,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                         break
                     if friction:
                         fric_c1 = friction_excess(problem, att.u)[0]
-            refused = (_constraint_refusal(problem, st, att, u, lam, to_end, cuts, ledger0, displacement_path)
-                       if ok else None)
+            refused = (_constraint_refusal(problem, st, att, u, lam, to_end, cuts, (ledger0, mat0),
+                                           displacement_path) if ok else None)
             if refused is not None:  # it meets its constraint for the wrong reason
                 ok, why, msg = False, refused, refused.message
             refused = (_jumped(problem, st, ps, att, n, lam, measure, area_prev, watch, probes_prev, floors)
@@ -817,7 +818,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                 # elements: 50 % of its interface debonded, then unloaded and "failed")
                 st.mode, st.size, st.changed = "arc", st.arc_length, True
                 continue
-            if st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0:
+            if (st.mode == "arc" and ps.dissipation and not tried_dissipation and lam != 0.0
+                    and not implex_only(problem)):
                 # e.g. at a peak where damage starts: the arc length cannot pick the branch, the
                 # dissipation constraint can (its predictor sign follows from the tangent)
                 tried_dissipation = True
@@ -881,8 +883,7 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                                    (fric_c0, fric_c1) if friction else None)
         st.dissipated += dG
         # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
-        damage = ledger_booked(problem)[1] if ledger0 is not None and problem.interfaces.cohesive() else None
-        dD = damage - ledger0[1] if damage is not None else None
+        dD, damage = damage_booked(problem, ledger0, mat0)
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
         warns += jump_warnings(n, att.lam, lam, area, area_prev, probes, probes_prev, ps.jump_area, ps.jump_ratio,
@@ -891,8 +892,12 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
         # step-size control: grow after easy increments, shrink after hard ones (Crisfield 1981)
         _next_size(problem, st, ps, att, abs(dlam) if st.mode == "load" else st.size, cuts, e_rel, dG, du, conj,
                    friction, displacement_path, (inc_min, inc_max, dl_min, dl_max))
+        if st.mode == "dissipation" and implex_only(problem):
+            st.mode, st.size = "arc", st.arc_length  # the arc length alone (implex_only)
         st.du_prev = du
-        st.changed = resolves > 0  # the next direction by the work criterion
+        # the next direction by the work criterion: after a re-solution (debonding), and always on
+        # IMPL-EX layers alone (implex_only), whose tangent within an increment is positive definite
+        st.changed = resolves > 0 or implex_only(problem)
         _stretch_bookkeeping(st, n, lam, att.lam, cuts, arc, warns)
         u, lam = att.u, att.lam
         st.reaction = conj[1] if conj is not None else math.nan
@@ -1037,39 +1042,48 @@ def _jumped(problem: Problem, st: PathState, ps: PathSettings, att: Attempt, n: 
 
 
 def _constraint_refusal(problem: Problem, st: PathState, att: Attempt, u: np.ndarray, lam: float, to_end: bool,
-                        cuts: int, ledger0: tuple[float, float] | None, displacement_path: bool) -> Reason | None:
+                        cuts: int, ledgers: tuple[tuple[float, float] | None, float | None],
+                        displacement_path: bool) -> Reason | None:
     """Why the converged increment ``att`` from (``u``, ``lam``) is refused although it meets its
-    constraint (it turned back, unloads elastically from a debonding state, or met the dissipation
-    constraint without damage), else None. ``ledger0``: the interfaces' ledger at its start."""
+    constraint (it turned back, unloads elastically from a damaging state, or met the dissipation
+    constraint without damage), else None. ``ledgers``: the interfaces' ledger and the layers'
+    materials' dissipation at its start (:func:`ledger_booked`, :func:`material_booked`)."""
+    ledger0, mat0 = ledgers
     if (st.mode == "arc" and not to_end and st.du_prev is not None and not st.changed and cuts < 3
             and float(((att.u - u) * (wf := full_weights(problem))) @ (st.du_prev * wf)) < 0.0):
         return Reason.TURNED_BACK  # cut; accepted after 3 cuts
     if (st.mode == "arc" and not displacement_path and lam == st.lam_damaged
-            and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0)):
+            and elastic_unloading(problem, att.lam - lam, att.u - u, ledger0, mat0, att.u)):
         # from a state whose increment damaged, the arc length found the elastic unloading
         # branch (the work criterion's direction at an indefinite tangent; the MMB on 100
         # elements, its crack past the load point, would go from λ = 0.6078 down so,
         # 'unloads without damage'): the dissipation constraint next, which demands damage
         return Reason.ELASTIC_UNLOADING
-    if ledger0 is not None and st.mode == "dissipation":
+    if (ledger0 is not None or mat0 is not None) and st.mode == "dissipation":
         # the constraint takes the stored energy to be the secant one; where the structure
         # unloads stiffer than the secant (crack faces closing, contact, friction) an
         # elastic path meets it without damage - the prescribed opening of the DCB on 100
         # elements would 'converge' from δ = 6.2 mm back to 0 in one increment. The interfaces'
-        # own ledger must book the dissipation. On displacement paths all of it counts; on
-        # force paths only damage, and only where the load falls (friction's work on
+        # and the layers' materials' own ledgers must book the dissipation (McNeice's cracking
+        # slab by arc length met the constraint while it unloaded from 4.2 to 2.9 kN, and later
+        # from 4.9 to 0.1 kN, its materials booking nothing). On displacement paths
+        # all of it counts; on force paths only damage, and only where the load falls (friction's work on
         # sliding points meets the constraint while the cohesive slab on 16 × 12 unloads
         # from 180.8 kN/m², its fracture ledger flat to 10⁻⁷, while load control
         # rises smoothly through 180 to 325; docs/performance.md); a snap-back books damage.
         # (Counting rising force increments too would refuse the lap shear with friction's
         # unloading past its peak, which `unloading` below stops with a clearer message.)
         # A refused increment is cut, then tried by the arc length, then by a rescue
+        bulk = material_booked(problem, att.u) - mat0 if mat0 is not None else 0.0  # (its trial state)
         if displacement_path:
-            if ledger_booked(problem)[0] - ledger0[0] < CONSTRAINT_BOOKED * st.size:
+            booked = (ledger_booked(problem)[0] - ledger0[0] if ledger0 is not None else 0.0) + bulk
+            if booked < CONSTRAINT_BOOKED * st.size:
                 return Reason.CLOSURE_REFUSED
-        elif (att.lam < lam and problem.interfaces.cohesive()
-              and ledger_booked(problem)[1] - ledger0[1] < CONSTRAINT_BOOKED * st.size):
-            return Reason.FRICTION_REFUSED
+        elif att.lam < lam:
+            cohesive = ledger0 is not None and problem.interfaces.cohesive()
+            booked = (ledger_booked(problem)[1] - ledger0[1] if cohesive else 0.0) + bulk
+            if (cohesive or mat0 is not None) and booked < CONSTRAINT_BOOKED * st.size:
+                return Reason.FRICTION_REFUSED if cohesive else Reason.UNBOOKED
     if st.mode == "dissipation" and lam * att.lam < 0.0:
         # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
         # λ = 0 the crack faces close and are stiffer than the secant, so an elastic path
@@ -1426,17 +1440,62 @@ def unloading(lam: float, dlam: float, work_rate: float, lam_damaged: float, lam
             and lam < lam_damaged - UNLOADING_FRACTION * lam_peak)
 
 
-def elastic_unloading(problem: Problem, dlam: float, du: np.ndarray, ledger0: tuple[float, float] | None) -> bool:
-    """Does a converged force-path increment (Δλ = ``dlam``, Δu = ``du``) unload without damage?
-    The load and its work-conjugate displacement fall (Δλ < 0, F̂·Δu < 0) while the cohesive
-    interfaces book no damage since ``ledger0`` (:func:`ledger_booked` at the increment's start;
-    None: no cohesive ledger, False). From a state on the debonding branch both branches are
-    equilibria; arc-length control is to follow the one that debonds (:func:`unloading` ends a
-    path that has followed the other far)."""
-    if ledger0 is None or not problem.interfaces.cohesive() or dlam >= 0.0:
+def elastic_unloading(problem: Problem, dlam: float, du: np.ndarray, ledger0: tuple[float, float] | None,
+                      mat0: float | None = None, u: np.ndarray | None = None) -> bool:
+    """Does a converged force-path increment (Δλ = ``dlam``, Δu = ``du``, to ``u``) unload
+    without damage? The load and its work-conjugate displacement fall (Δλ < 0, F̂·Δu < 0) while
+    the cohesive interfaces and the layers' materials book no damage since ``ledger0`` and
+    ``mat0`` (:func:`damage_booked`; neither ledger: False). From a state on the damaging branch
+    both branches are equilibria; arc-length control is to follow the one that damages
+    (:func:`unloading` ends a path that has followed the other far)."""
+    if dlam >= 0.0:
         return False
-    damage = ledger_booked(problem)[1]
-    return float(problem.F_scaled @ du) < 0.0 and not beyond_round_off(damage - ledger0[1], damage)
+    dD, damage = damage_booked(problem, ledger0, mat0, u)
+    return dD is not None and float(problem.F_scaled @ du) < 0.0 and not beyond_round_off(dD, damage)
+
+
+def implex_only(problem: Problem) -> bool:
+    """Do only layers integrated by IMPL-EX dissipate (no cohesive interface)? Then the arc length
+    alone follows the path, without Verhoosel's switch to the dissipation constraint. Within an
+    increment such a layer acts with the damage extrapolated from the last increments, so the
+    damage the increment adds is set before its iterations, and the constraint ΔG = Δτ can only
+    choose λ to match it: on McNeice's cracking slab by arc length every dissipation-controlled
+    increment from 7.2 kN on converged with λ falling (from λ = 0.600, Δτ = 11.4 to 0.582, half
+    of it to 0.286, and so on down with each cut), its layers booking no dissipation, while the
+    arc length's increments rise with load control's in 3 iterations each."""
+    mats = getattr(getattr(problem, "assembler", None), "materials", None)
+    if mats is None or not mats.active or getattr(mats, "integration", "") != "implex":
+        return False
+    cohesive = getattr(getattr(problem, "interfaces", None), "cohesive", None)
+    return not (cohesive is not None and cohesive())
+
+
+def material_booked(problem: Problem, u: np.ndarray | None = None) -> float | None:
+    """The energy the layers' materials (concrete cracking and crushing, steel yielding) have
+    dissipated: committed, or in the trial state at ``u`` before its commit; None where no layer
+    has a material with a history."""
+    asm = getattr(problem, "assembler", None)
+    mats = getattr(asm, "materials", None)
+    if mats is None or not mats.active:
+        return None
+    return asm.material_dissipation(u)
+
+
+def damage_booked(problem: Problem, ledger0: tuple[float, float] | None, mat0: float | None,
+                  u: np.ndarray | None = None) -> tuple[float | None, float | None]:
+    """(booked in the increment, booked so far) of the damage energy: the cohesive interfaces'
+    ledger since ``ledger0`` (:func:`ledger_booked`) and the layers' materials' dissipation
+    since ``mat0`` (:func:`material_booked`, at the trial state ``u`` where given); (None, None)
+    where there is neither ledger."""
+    cohesive = ledger0 is not None and problem.interfaces.cohesive()
+    if not cohesive and mat0 is None:
+        return None, None
+    so_far = ledger_booked(problem)[1] if cohesive else 0.0
+    dD = so_far - ledger0[1] if cohesive else 0.0
+    if mat0 is not None:
+        m = material_booked(problem, u)
+        so_far, dD = so_far + m, dD + m - mat0
+    return dD, so_far
 
 
 def beyond_round_off(booked: float, total: float) -> bool:

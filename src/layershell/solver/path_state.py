@@ -32,6 +32,7 @@ class Reason(Enum):
     PROBE_JUMP = "probe jump"
     FRICTION_REFUSED = "the dissipation constraint was met by friction on unloading, not by damage"
     CLOSURE_REFUSED = "the dissipation constraint was met by closure, not damage"
+    UNBOOKED = "the dissipation constraint was met while the materials booked no dissipation (unloading)"
     CROSSED_ZERO = "the dissipation constraint crossed λ = 0 (closure, not damage)"
     TURNED_BACK = "the increment turned back along the path"
     ELASTIC_UNLOADING = "the increment unloads elastically from a debonding state"
