@@ -120,7 +120,7 @@ def test_implex_layers_alone_keep_the_arc_length_and_the_work_criterion(monkeypa
         assert [fresh for _, fresh in tried] == [False, True, True]
     from types import SimpleNamespace
 
-    pb.interfaces = SimpleNamespace(cohesive=lambda: True)  # with cohesive interfaces: as before
+    pb.interfaces = SimpleNamespace(cohesive=lambda: True)  # with a cohesive interface the dissipation constraint stays
     assert not al.implex_only(pb)
 
 
