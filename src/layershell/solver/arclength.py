@@ -882,7 +882,8 @@ def path_steps(problem: Problem, s: NewtonSettings, ps: PathSettings, u0: np.nda
                                    None if conj is None else (st.reaction, conj[1]),
                                    (fric_c0, fric_c1) if friction else None)
         st.dissipated += dG
-        # the damage the interfaces' ledger booked in this increment (None: no cohesive ledger)
+        # the damage the interfaces' ledger and the layers' materials booked in this increment
+        # (None: neither ledger)
         dD, damage = damage_booked(problem, ledger0, mat0)
         area = measure(problem) if measure is not None else None
         probes = watch(att.u, att.lam) if watch is not None else None
@@ -1074,15 +1075,15 @@ def _constraint_refusal(problem: Problem, st: PathState, att: Attempt, u: np.nda
         # (Counting rising force increments too would refuse the lap shear with friction's
         # unloading past its peak, which `unloading` below stops with a clearer message.)
         # A refused increment is cut, then tried by the arc length, then by a rescue
-        bulk = material_booked(problem, att.u) - mat0 if mat0 is not None else 0.0  # (its trial state)
         if displacement_path:
+            bulk = material_booked(problem, att.u) - mat0 if mat0 is not None else 0.0  # (its trial state)
             booked = (ledger_booked(problem)[0] - ledger0[0] if ledger0 is not None else 0.0) + bulk
             if booked < CONSTRAINT_BOOKED * st.size:
                 return Reason.CLOSURE_REFUSED
         elif att.lam < lam:
-            cohesive = ledger0 is not None and problem.interfaces.cohesive()
-            booked = (ledger_booked(problem)[1] - ledger0[1] if cohesive else 0.0) + bulk
-            if (cohesive or mat0 is not None) and booked < CONSTRAINT_BOOKED * st.size:
+            dD, _ = damage_booked(problem, ledger0, mat0, att.u)
+            if dD is not None and dD < CONSTRAINT_BOOKED * st.size:
+                cohesive = ledger0 is not None and problem.interfaces.cohesive()
                 return Reason.FRICTION_REFUSED if cohesive else Reason.UNBOOKED
     if st.mode == "dissipation" and lam * att.lam < 0.0:
         # ΔG = ½F̂ᵀ(λ₀Δu − Δλu₀) is the dissipation of damage with secant unloading; past
